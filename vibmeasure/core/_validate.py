@@ -1,0 +1,76 @@
+"""Boundary checks shared by the public functions (each error names the argument and the rule)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import ParameterError
+from .record import Record
+
+__all__ = ["as_record", "response_channel", "clean_signal", "check_band", "positive"]
+
+
+def as_record(obj, *, fs: float | None = None, name: str = "rec") -> Record:
+    """Accept a Record, or an array together with ``fs``."""
+    if isinstance(obj, Record):
+        if fs is not None and float(fs) != obj.fs:
+            raise ParameterError(f"{fs=} contradicts the record's fs={obj.fs}; drop fs or resample")
+        return obj
+    if isinstance(obj, (np.ndarray, list, tuple)):
+        if fs is None:
+            raise ParameterError(f"{name} is a bare array: fs (Hz) is required; or pass a vm.Record")
+        return Record.from_array(np.asarray(obj), fs=fs)
+    raise ParameterError(f"{name} must be a vm.Record or an array with fs, got {type(obj).__name__}")
+
+
+def response_channel(rec: Record, channel) -> int:
+    """The channel to analyse: the one named, the only one, or the first that is not a force."""
+    if channel is not None:
+        return rec.index(channel)
+    if rec.n_channels == 1:
+        return 0
+    for i, c in enumerate(rec.channels):
+        if c.quantity != "force":
+            return i
+    raise ParameterError(f"channel=None but every channel of {rec.names} is a force; name the response channel")
+
+
+def clean_signal(rec: Record, idx: int, *, min_samples: int = 16, what: str = "rec") -> np.ndarray:
+    """One channel as float64, refusing empty, too short, non-finite and constant data."""
+    x = np.asarray(rec.data[idx], dtype=np.float64)
+    name = rec.channels[idx].name
+    if x.size == 0:
+        raise ParameterError(f"{what} channel {name!r} is empty (0 samples)")
+    if x.size < min_samples:
+        raise ParameterError(f"{what} channel {name!r} has {x.size} samples; at least {min_samples} are needed")
+    bad = ~np.isfinite(x)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ParameterError(f"{what} channel {name!r} has {int(bad.sum())} NaN/inf samples (first at index {i}, "
+                             f"t={i / rec.fs:g} s); the rule is finite data: repair or cut the record first")
+    if np.ptp(x) == 0:
+        raise ParameterError(f"{what} channel {name!r} is constant ({x[0]!r}): there is no vibration to analyse")
+    return x
+
+
+def check_band(band, fs: float, *, name: str = "band") -> tuple[float, float] | None:
+    """Validate a (lo, hi) band in Hz inside 0..fs/2."""
+    if band is None:
+        return None
+    try:
+        lo, hi = (float(b) for b in band)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}={band!r} must be a pair (lo, hi) in Hz") from None
+    if not (np.isfinite(lo) and np.isfinite(hi)) or lo < 0 or hi <= lo or hi > fs / 2:
+        raise ParameterError(f"{name}={band!r} must satisfy 0 <= lo < hi <= fs/2 = {fs / 2:g} Hz")
+    return lo, hi
+
+
+def positive(value, name: str, *, allow_zero: bool = False) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}={value!r} must be a number") from None
+    if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
+        raise ParameterError(f"{name}={value!r} must be finite and {'>= 0' if allow_zero else '> 0'}")
+    return v

@@ -1,0 +1,61 @@
+"""Files in and out: ``read`` and ``write`` choose the format by the file's ending."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..core.errors import ParameterError
+from ..core.record import Record
+from .csvfile import read_csv, write_csv
+from .hdf5 import read_hdf5, write_hdf5
+from .lvm import read_lvm
+from .mat import read_mat
+from .wav import read_wav, write_wav
+
+__all__ = ["read", "write", "FORMATS"]
+
+_READERS = {".csv": read_csv, ".txt": read_csv, ".tsv": read_csv, ".h5": read_hdf5, ".hdf5": read_hdf5,
+            ".wav": read_wav, ".mat": read_mat, ".lvm": read_lvm}
+_WRITERS = {".csv": write_csv, ".h5": write_hdf5, ".hdf5": write_hdf5, ".wav": write_wav}
+FORMATS = tuple(sorted(_READERS))
+
+
+def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, quantity: str | None = None,
+         unit: str | None = None, dataset: str | None = None) -> Record:
+    """Read a measurement file into a :class:`Record`.
+
+    The format follows the ending: .csv/.txt/.tsv, .h5/.hdf5, .wav, .mat (v5 and v7.3), .lvm.
+    ``fs`` is required when the file holds no timing information and must agree with it
+    otherwise. ``channels`` selects columns/variables by name (dotted paths for MATLAB structs,
+    ``"name[i]"`` for one row of a matrix) or position; ``quantity`` and ``unit`` label the data
+    when the file does not. ``dataset`` names a bare dataset in a foreign HDF5 file.
+    """
+    p = Path(path)
+    if not p.exists():
+        raise ParameterError(f"path={str(path)!r} does not exist")
+    if p.is_dir():
+        raise ParameterError(f"path={str(path)!r} is a folder, not a file")
+    ext = p.suffix.lower()
+    if ext not in _READERS:
+        raise ParameterError(f"path={str(path)!r}: unknown file type {ext!r}; readable: {FORMATS}")
+    if p.stat().st_size == 0:
+        raise ParameterError(f"path={str(path)!r} is empty (0 bytes)")
+    kw = dict(fs=fs, channels=channels, quantity=quantity, unit=unit)
+    if dataset is not None:
+        if ext not in (".h5", ".hdf5"):
+            raise ParameterError(f"dataset={dataset!r} applies to HDF5 files only, not {ext!r}")
+        kw["dataset"] = dataset
+    return _READERS[ext](p, **kw)
+
+
+def write(path: str | os.PathLike, obj) -> Path:
+    """Write a :class:`Record` to .csv, .h5/.hdf5 or .wav, atomically (never half-written)."""
+    p = Path(path)
+    ext = p.suffix.lower()
+    if not isinstance(obj, Record):
+        raise ParameterError(f"obj must be a vm.Record to write {ext!r}, got {type(obj).__name__}")
+    if ext not in _WRITERS:
+        raise ParameterError(f"path={str(path)!r}: cannot write {ext!r}; writable: {tuple(sorted(_WRITERS))}")
+    _WRITERS[ext](p, obj)
+    return p

@@ -1,0 +1,164 @@
+"""CSV text: a time column or a sampling-rate header; comma, semicolon or tab; decimal comma."""
+
+from __future__ import annotations
+
+import io
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import ParameterError
+from ..core.record import Record
+from ._common import atomic_path, fs_from_time, make_record, require_fs, select_names
+
+_FS_KEYS = ("fs", "fs_hz", "sampling_rate", "sample_rate", "samplerate", "sampling_frequency")
+_TIME_NAMES = ("time", "t", "zeit", "seconds", "time_s", "timestamp")
+_NAME_UNIT = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]*)\s*[\])]\s*$")
+
+
+def _split_name_unit(label: str) -> tuple[str, str | None]:
+    m = _NAME_UNIT.match(label)
+    return (m.group(1), m.group(2)) if m else (label.strip(), None)
+
+
+def _sniff(lines: list[str]) -> tuple[str, str]:
+    """Delimiter and decimal mark from the first data lines."""
+    sample = "\n".join(lines[:20])
+    if "\t" in sample:
+        sep = "\t"
+    elif ";" in sample:
+        sep = ";"
+    else:
+        sep = ","
+    decimal = "."
+    if sep != ",":
+        if re.search(r"\d,\d", sample) and not re.search(r"\d\.\d", sample):
+            decimal = ","
+    return sep, decimal
+
+
+def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None) -> Record:
+    import pandas as pd
+    src = f"CSV file {str(path)!r}"
+    try:
+        text = Path(path).read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError:
+        raise ParameterError(f"{src} is not UTF-8 text: unreadable as CSV") from None
+    lines = text.splitlines()
+    header_kv: dict[str, str] = {}
+    chan_meta: dict[str, tuple[str, str]] = {}
+    body = []
+    for ln in lines:
+        s = ln.strip()
+        if s.startswith("#"):
+            m = re.match(r"#\s*([\w .]+?)\s*[=:]\s*(.*)$", s)
+            if m:
+                key, val = m.group(1).strip().lower(), m.group(2).strip()
+                if key == "channel":
+                    parts = [p.strip() for p in val.split(";")]
+                    if len(parts) >= 3:
+                        chan_meta[parts[0]] = (parts[1], parts[2])
+                else:
+                    header_kv[key] = val
+            continue
+        if s:
+            body.append(ln)
+    if not body:
+        raise ParameterError(f"{src} has no data rows")
+    sep, decimal = _sniff(body[1:] if len(body) > 1 else body)
+    first = body[0].split(sep)
+    has_header = any(not _is_number(f, decimal) for f in first if f.strip())
+    if sep == "," and decimal == "." and has_header and len(body) > 1:
+        # a decimal comma with a comma separator cannot be told apart: reject clearly
+        n_head = len(first)
+        n_row = len(body[1].split(","))
+        if n_row != n_head:
+            raise ParameterError(f"{src}: header has {n_head} fields but row 2 has {n_row}; a decimal comma "
+                                 "with a comma separator is ambiguous: use ';' or tab as separator")
+    try:
+        df = pd.read_csv(io.StringIO("\n".join(body)), sep=sep, decimal=decimal,
+                         header=0 if has_header else None, skipinitialspace=True, engine="c")
+    except Exception as exc:  # pandas raises many types for malformed text
+        raise ParameterError(f"{src} is not readable as CSV: {exc}") from None
+    df = df.dropna(axis=1, how="all")  # trailing separators
+    if not has_header:
+        df.columns = [f"ch{i}" for i in range(df.shape[1])]
+    labels = [str(c) for c in df.columns]
+    for c in df.columns:
+        if df[c].dtype.kind not in "fiu":
+            raise ParameterError(f"{src}: column {str(c)!r} holds non-numeric values (decimal mark "
+                                 f"{decimal!r}, separator {sep!r})")
+    values = df.to_numpy(dtype=np.float64)
+    if values.shape[0] == 0:
+        raise ParameterError(f"{src} has a header but no data rows")
+    nan_rows = np.flatnonzero(np.isnan(values).any(axis=1))
+    if nan_rows.size:
+        r = int(nan_rows[0]) + 1 + int(has_header)
+        raise ParameterError(f"{src}: data row {r} has missing values"
+                             f"{' (truncated file?)' if nan_rows[0] == values.shape[0] - 1 else ''}")
+    names, units = [], []
+    for lab in labels:
+        nm, un = _split_name_unit(lab)
+        names.append(nm)
+        units.append(un)
+    tcol = next((i for i, n in enumerate(names) if n.lower() in _TIME_NAMES), None)
+    t0 = 0.0
+    file_fs = None
+    for k in _FS_KEYS:
+        if k in header_kv:
+            try:
+                file_fs = float(header_kv[k].split()[0].replace(",", "."))
+            except ValueError:
+                raise ParameterError(f"{src}: header {k} = {header_kv[k]!r} is not a number") from None
+    if tcol is not None:
+        tscale = {"ms": 1e-3, "us": 1e-6, "s": 1.0, None: 1.0, "": 1.0}.get(units[tcol], None)
+        if tscale is None:
+            raise ParameterError(f"{src}: time column unit {units[tcol]!r} is not s, ms or us")
+        col_fs, t0 = fs_from_time(values[:, tcol] * tscale, source=src)
+        if file_fs is not None and abs(col_fs - file_fs) > 1e-6 * file_fs:
+            raise ParameterError(f"{src}: header fs={file_fs:g} Hz contradicts the time column ({col_fs:g} Hz)")
+        file_fs = file_fs or col_fs  # the header's exact value wins when both agree
+    if fs is not None:
+        fs = require_fs(fs, source=src)
+        if file_fs is not None and abs(fs - file_fs) > 1e-6 * file_fs:
+            raise ParameterError(f"fs={fs:g} contradicts {src}, whose timing gives {file_fs:g} Hz")
+    fs = file_fs if file_fs is not None else require_fs(fs, source=src)
+    if "t0_s" in header_kv:
+        t0 = float(header_kv["t0_s"])
+    data_cols = [i for i in range(len(names)) if i != tcol]
+    if not data_cols:
+        raise ParameterError(f"{src} has a time column but no data column")
+    avail = [names[i] for i in data_cols]
+    pick = [data_cols[j] for j in select_names(avail, channels, source=src)]
+    quantities = [chan_meta.get(names[i], ("unknown", ""))[0] for i in pick]
+    file_units = [chan_meta.get(names[i], (None, units[i] or ""))[1] for i in pick]
+    meta = {k: v for k, v in header_kv.items() if k not in _FS_KEYS and k != "t0_s"}
+    meta["source"] = str(path)
+    return make_record(values[:, pick].T, fs, [names[i] for i in pick], quantity=quantity, unit=unit,
+                       quantities=quantities, units=file_units, t0=t0, meta=meta, source=src)
+
+
+def _is_number(s: str, decimal: str) -> bool:
+    s = s.strip()
+    if decimal == ",":
+        s = s.replace(",", ".")
+    try:
+        float(s)
+        return True
+    except ValueError:
+        return False
+
+
+def write_csv(path, rec: Record, *, time_column: bool = True) -> None:
+    """Write a record as CSV: metadata in '#' header lines, a time column, full float precision."""
+    head = ["# vibmeasure record, schema 1", f"# fs_hz = {rec.fs!r}", f"# t0_s = {rec.t0!r}"]
+    for c in rec.channels:
+        head.append(f"# channel = {c.name}; {c.quantity}; {c.unit}; {c.location}")
+    cols = ([f"time [s]"] if time_column else []) + [f"{c.name} [{c.unit}]" if c.unit else c.name
+                                                      for c in rec.channels]
+    arr = np.vstack([rec.time, rec.data]).T if time_column else rec.data.T
+    with atomic_path(path) as tmp:
+        with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
+            fh.write("\n".join(head) + "\n" + ",".join(cols) + "\n")
+            np.savetxt(fh, arr, delimiter=",", fmt="%.17g")

@@ -1,0 +1,108 @@
+"""HDF5: vibmeasure's own record schema (exact round trip), or any bare dataset given fs.
+
+Schema "vibmeasure.record", version 1::
+
+    /            attrs: vibmeasure_schema="vibmeasure.record", schema_version=1
+    /data        float dataset (n_channels, n_samples); attrs fs (Hz), t0 (s)
+                 attrs channel_names, channel_quantities, channel_units, channel_locations
+    /            attrs meta (JSON), history (JSON list)
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ..core.errors import ParameterError
+from ..core.record import Channel, Record
+from ._common import atomic_path, make_record, require_fs, select_names
+
+SCHEMA = "vibmeasure.record"
+SCHEMA_VERSION = 1
+
+
+def _open(path):
+    import h5py
+    try:
+        return h5py.File(path, "r")
+    except (OSError, ValueError) as exc:
+        raise ParameterError(f"HDF5 file {str(path)!r} is unreadable (truncated or not HDF5): {exc}") from None
+
+
+def _str_list(a) -> list[str]:
+    return [x.decode() if isinstance(x, bytes) else str(x) for x in np.atleast_1d(a)]
+
+
+def read_hdf5(path, *, fs=None, channels=None, quantity=None, unit=None, dataset=None) -> Record:
+    src = f"HDF5 file {str(path)!r}"
+    with _open(path) as f:
+        schema = f.attrs.get("vibmeasure_schema")
+        schema = schema.decode() if isinstance(schema, bytes) else schema
+        if schema == SCHEMA and dataset is None:
+            ver = int(f.attrs.get("schema_version", -1))
+            if ver > SCHEMA_VERSION:
+                raise ParameterError(f"{src} has schema_version {ver}; this vibmeasure reads up to {SCHEMA_VERSION}")
+            try:
+                d = f["data"]
+                data = d[()]
+                a = d.attrs
+                chans = [Channel(n, q, u, loc) for n, q, u, loc in zip(
+                    _str_list(a["channel_names"]), _str_list(a["channel_quantities"]),
+                    _str_list(a["channel_units"]), _str_list(a["channel_locations"]))]
+                rfs, t0 = float(a["fs"]), float(a["t0"])
+                meta = json.loads(f.attrs.get("meta", "{}"))
+                history = tuple(json.loads(f.attrs.get("history", "[]")))
+            except (KeyError, OSError, ValueError) as exc:
+                raise ParameterError(f"{src} claims schema {SCHEMA} but is damaged: {exc}") from None
+            if fs is not None and float(fs) != rfs:
+                raise ParameterError(f"fs={fs} contradicts {src}, which stores fs={rfs}")
+            rec = Record(data, rfs, tuple(chans), t0=t0, meta=meta, history=history)
+            if channels is not None:
+                rec = rec.select([rec.names[i] for i in select_names(rec.names, channels, source=src)])
+            if quantity is not None or unit is not None:
+                rec = make_record(rec.data, rec.fs, rec.names, quantity=quantity, unit=unit,
+                                  quantities=[c.quantity for c in rec.channels],
+                                  units=[c.unit for c in rec.channels], t0=rec.t0, meta=rec.meta, source=src)
+            return rec
+        # a bare dataset: the caller names it and gives fs (or it carries an fs attribute)
+        if dataset is None:
+            names = []
+            f.visititems(lambda n, o: names.append(n) if hasattr(o, "shape") and o.ndim in (1, 2) else None)
+            if len(names) != 1:
+                raise ParameterError(f"{src} is not a vibmeasure record file; name the dataset "
+                                     f"(dataset=...) among {names}")
+            dataset = names[0]
+        if dataset not in f:
+            raise ParameterError(f"dataset={dataset!r} is not in {src}")
+        d = f[dataset]
+        try:
+            data = np.asarray(d[()], dtype=np.float64)
+        except (OSError, TypeError, ValueError) as exc:
+            raise ParameterError(f"{src}: dataset {dataset!r} is unreadable: {exc}") from None
+        attr_fs = next((float(d.attrs[k]) for k in ("fs", "sampling_rate", "fs_hz") if k in d.attrs), None)
+        fs = attr_fs if fs is None and attr_fs is not None else require_fs(fs, source=f"{src} dataset {dataset!r}")
+    if data.ndim == 1:
+        data = data[np.newaxis]
+    base = dataset.strip("/").replace("/", ".")
+    names = [base] if data.shape[0] == 1 else [f"{base}[{i}]" for i in range(data.shape[0])]
+    pick = select_names(names, channels, source=src)
+    return make_record(data[pick], fs, [names[i] for i in pick], quantity=quantity, unit=unit,
+                       meta={"source": str(path), "dataset": dataset}, source=src)
+
+
+def write_hdf5(path, rec: Record) -> None:
+    import h5py
+    with atomic_path(path) as tmp:
+        with h5py.File(tmp, "w") as f:
+            f.attrs["vibmeasure_schema"] = SCHEMA
+            f.attrs["schema_version"] = SCHEMA_VERSION
+            f.attrs["meta"] = json.dumps(dict(rec.meta), default=str)
+            f.attrs["history"] = json.dumps(list(rec.history))
+            d = f.create_dataset("data", data=rec.data, chunks=True if rec.data.size > 2 ** 16 else None)
+            d.attrs["fs"] = rec.fs
+            d.attrs["t0"] = rec.t0
+            d.attrs["channel_names"] = [c.name for c in rec.channels]
+            d.attrs["channel_quantities"] = [c.quantity for c in rec.channels]
+            d.attrs["channel_units"] = [c.unit for c in rec.channels]
+            d.attrs["channel_locations"] = [c.location for c in rec.channels]

@@ -1,0 +1,160 @@
+"""MATLAB .mat files: v4/v5 through scipy.io, v7.3 (HDF5) through h5py.
+
+Variables and nested struct fields are addressed by dotted paths (``"bearing.gs"``,
+``"Fe.Out.Acc"``); a matrix variable gives one channel per row (``"Fe.Out.Acc[0]"``). The
+sampling rate comes from ``fs``, a sample-rate variable in the file, or a time vector.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import Counter
+
+import numpy as np
+
+from ..core.errors import ParameterError
+from ..core.record import Record
+from ._common import fs_from_time, make_record, require_fs
+
+_TIME_LEAF = re.compile(r"^(time|t|time_domain|timevector|tvec|time_s)$", re.I)
+_FS_LEAF = re.compile(r"^(fs|sr|samplerate|sample_rate|sampling_rate|samplingrate|.*_sample_rate|fsamp)$", re.I)
+_RPM_LEAF = re.compile(r".*rpm$", re.I)
+
+
+def _leaves_v5(path) -> dict[str, np.ndarray]:
+    import scipy.io as sio
+    try:
+        raw = sio.loadmat(path, squeeze_me=False, struct_as_record=True)
+    except NotImplementedError:
+        raise _V73() from None
+    except Exception as exc:  # scipy raises ValueError, TypeError, OSError... for damaged files
+        raise ParameterError(f"MAT file {str(path)!r} is unreadable (truncated or not MATLAB): {exc}") from None
+    out: dict[str, np.ndarray] = {}
+
+    def walk(prefix, v):
+        if isinstance(v, np.ndarray) and v.dtype.names:
+            if v.size == 1:
+                for fld in v.dtype.names:
+                    walk(f"{prefix}.{fld}", v[fld].flat[0])
+        elif isinstance(v, np.ndarray) and v.dtype == object:
+            if v.size == 1:
+                walk(prefix, v.flat[0])
+        elif isinstance(v, np.ndarray) and v.dtype.kind in "fiucb":
+            out[prefix] = v
+    for k, v in raw.items():
+        if not k.startswith("__"):
+            walk(k, v)
+    return out
+
+
+class _V73(Exception):
+    pass
+
+
+def _leaves_v73(path) -> dict[str, np.ndarray]:
+    import h5py
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise ParameterError(f"MAT file {str(path)!r} is unreadable (truncated, or v7.3 damaged): {exc}") from None
+    out: dict[str, np.ndarray] = {}
+    with f:
+        def visit(name, obj):
+            if name.startswith("#refs#") or not isinstance(obj, h5py.Dataset):
+                return
+            if obj.dtype.kind not in "fiucb" and not obj.dtype.names:
+                return
+            a = obj[()]
+            if a.dtype.names and set(a.dtype.names) >= {"real", "imag"}:
+                a = a["real"] + 1j * a["imag"]
+            out[name.replace("/", ".")] = np.asarray(a).T  # MATLAB is column-major
+        f.visititems(visit)
+    return out
+
+
+def _signal_rows(a: np.ndarray) -> np.ndarray | None:
+    """A leaf as (n_rows, n_samples) with time along the longer axis; None for scalars/3-D."""
+    a = np.asarray(a)
+    if a.ndim > 2 or a.size < 2:
+        return None
+    a = np.atleast_2d(a)
+    return a if a.shape[1] >= a.shape[0] else a.T
+
+
+def read_mat(path, *, fs=None, channels=None, quantity=None, unit=None) -> Record:
+    src = f"MAT file {str(path)!r}"
+    try:
+        leaves = _leaves_v5(path)
+    except _V73:
+        leaves = _leaves_v73(path)
+    if not leaves:
+        raise ParameterError(f"{src} holds no numeric variables")
+    scalars = {k: v for k, v in leaves.items() if np.asarray(v).size == 1}
+    signals = {k: r for k, v in leaves.items() if (r := _signal_rows(v)) is not None and r.dtype.kind != "c"}
+    last = {k: k.split(".")[-1] for k in signals}
+    times = {k: r for k, r in signals.items() if _TIME_LEAF.match(last[k]) and r.shape[0] == 1}
+
+    # the channels: named ones, or every signal of the dominant length
+    rows: list[np.ndarray] = []
+    names: list[str] = []
+    if channels is not None:
+        want = [channels] if isinstance(channels, str) else list(channels)
+        for w in want:
+            m = re.match(r"^(.*)\[(\d+)\]$", str(w))
+            base, row = (m.group(1), int(m.group(2))) if m else (str(w), None)
+            if base not in signals:
+                raise ParameterError(f"channels={want!r}: {base!r} is not a signal in {src}; "
+                                     f"signals: {sorted(signals)}")
+            r = signals[base]
+            if row is not None:
+                if row >= r.shape[0]:
+                    raise ParameterError(f"channels={want!r}: {base!r} has {r.shape[0]} rows, not row {row}")
+                rows.append(r[row]); names.append(f"{base}[{row}]")
+            else:
+                rows.extend(r)
+                names.extend([base] if r.shape[0] == 1 else [f"{base}[{i}]" for i in range(r.shape[0])])
+        lengths = {len(x) for x in rows}
+        if len(lengths) != 1:
+            raise ParameterError(f"channels={want!r} have different lengths {sorted(lengths)} in {src}")
+    else:
+        cand = {k: r for k, r in signals.items() if k not in times}
+        if not cand:
+            raise ParameterError(f"{src} holds no signal variables (only {sorted(leaves)})")
+        if times:
+            n_star = next(iter(times.values())).shape[1]
+        else:
+            count = Counter()
+            for r in cand.values():
+                count[r.shape[1]] += r.shape[0]
+            n_star = max(count, key=lambda n: (count[n], n))
+        for k, r in cand.items():
+            if r.shape[1] == n_star:
+                rows.extend(r)
+                names.extend([k] if r.shape[0] == 1 else [f"{k}[{i}]" for i in range(r.shape[0])])
+        if not rows:
+            raise ParameterError(f"{src}: no signal matches the time vector's length {n_star}")
+    n = len(rows[0])
+    data = np.vstack([np.asarray(x, dtype=np.float64) for x in rows])
+
+    # the sampling rate
+    file_fs, t0 = None, 0.0
+    for k, v in scalars.items():
+        if _FS_LEAF.match(k.split(".")[-1]):
+            file_fs = float(np.asarray(v).ravel()[0])
+            break
+    if file_fs is None:
+        prefix = names[0].split("[")[0].rsplit(".", 1)[0]
+        tkeys = sorted((k for k, r in times.items() if r.shape[1] == n),
+                       key=lambda k: 0 if k.rsplit(".", 1)[0] == prefix else 1)
+        if tkeys:
+            file_fs, t0 = fs_from_time(times[tkeys[0]][0], source=f"{src} time vector {tkeys[0]!r}")
+    if fs is not None:
+        fs = require_fs(fs, source=src)
+        if file_fs is not None and abs(fs - file_fs) > 1e-6 * file_fs:
+            raise ParameterError(f"fs={fs:g} contradicts {src}, whose timing gives {file_fs:g} Hz")
+    fs = file_fs if file_fs is not None else require_fs(fs, source=src)
+    meta = {"source": str(path)}
+    for k, v in scalars.items():
+        if _RPM_LEAF.match(k.split(".")[-1]):
+            meta["rpm"] = float(np.asarray(v).ravel()[0])
+    return make_record(data, fs, names, quantity=quantity, unit=unit, t0=t0, meta=meta, source=src)
