@@ -1,0 +1,1 @@
+"""Identification: fn, zeta, FRFs and modes from measurements."""

@@ -1,0 +1,142 @@
+"""Shared pieces of the free-decay methods: noise level, clipping, decay start, cycle peaks."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import signal as _sig
+from scipy.ndimage import uniform_filter1d
+
+from ..core.record import Record
+
+CLIP_RUN = 3  # consecutive samples at the extreme that count as clipping
+
+
+def clipped_mask(x: np.ndarray) -> np.ndarray:
+    """True where a run of CLIP_RUN or more consecutive samples sits at the record's max or min."""
+    mask = np.zeros(x.size, bool)
+    tol = 1e-12 * max(np.ptp(x), np.finfo(float).tiny)
+    for ext in (x.max(), x.min()):
+        at = np.abs(x - ext) <= tol
+        if at.sum() < CLIP_RUN:
+            continue
+        d = np.diff(np.concatenate(([0], at.view(np.int8), [0])))
+        starts, ends = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
+        for s, e in zip(starts, ends):
+            if e - s >= CLIP_RUN:
+                mask[s:e] = True
+    return mask
+
+
+def noise_std(x: np.ndarray, fs: float) -> float:
+    """Broadband noise std from the median level of a Welch PSD (robust to sparse spectral lines)."""
+    n = x.size
+    nper = int(min(n, max(64, 2 ** int(np.log2(max(n // 16, 64))))))
+    nper = min(nper, 4096)
+    f, p = _sig.welch(x, fs=fs, nperseg=nper, detrend="linear")
+    p = p[1:-1] if p.size > 4 else p
+    segs = max(1, 2 * n // nper - 1)
+    # median of an average of K chi^2_2 variables: mean * (1 - 2/(9K))^3 (Wilson-Hilferty)
+    k = segs
+    med_to_mean = (1 - 2 / (9 * k)) ** 3 if k > 1 else np.log(2)
+    level = np.median(p) / med_to_mean
+    return float(np.sqrt(level * fs / 2))
+
+
+def decay_start(rec: Record, idx: int, x: np.ndarray) -> tuple[int, str]:
+    """Index where the free decay starts and how it was found.
+
+    After the last sample of the force pulse when the record has a force channel; after the
+    trigger when the record begins with quiet pre-trigger data; otherwise at the first sample.
+    """
+    forces = [i for i, c in enumerate(rec.channels) if c.quantity == "force" and i != idx]
+    if forces:
+        f = np.abs(np.asarray(rec.data[forces[0]], float) - np.median(rec.data[forces[0]]))
+        ip = int(np.argmax(f))
+        above = f[ip:] > 0.02 * f[ip]
+        end = ip + (int(np.argmin(above)) if not above.all() else above.size)
+        return min(end + 1, x.size - 1), "after force pulse"
+    nb = max(8, x.size // 400)
+    nblk = x.size // nb
+    if nblk < 4:
+        return 0, "start"
+    blocks = x[: nblk * nb].reshape(nblk, nb)
+    rms = blocks.std(axis=1)
+    if rms[0] >= 0.25 * rms.max():
+        return 0, "start"
+    j = int(np.argmax(rms > 0.5 * rms.max()))
+    seg = np.abs(x[j * nb:(j + 2) * nb] - np.median(x[: max(nb, j * nb)]))
+    return j * nb + int(np.argmax(seg)), "after trigger"
+
+
+def cycle_peaks(x: np.ndarray, fs: float, fd: float) -> tuple[np.ndarray, np.ndarray]:
+    """Half-cycle amplitudes of an oscillation at about ``fd`` Hz.
+
+    The baseline (DC, drift) is a moving average over one period; each half-cycle's extreme is
+    refined by a least-squares parabola over +-0.1 period and paired with the next extreme of
+    opposite sign: amplitude (peak - trough)/2 at the midpoint time. Offsets cancel, and the
+    constant factors from the parabola and the half-cycle decay cancel in any log-slope.
+    Returns (times in s, amplitudes).
+    """
+    per = fs / fd
+    base = uniform_filter1d(x, size=max(3, int(round(per))), mode="nearest")
+    y = x - base
+    h = max(1, int(round(0.1 * per)))
+    # extremes between zero crossings, with hysteresis against noise-born crossings
+    sgn = np.sign(y)
+    zc = np.flatnonzero(np.diff(sgn) != 0)
+    if zc.size < 3:
+        return np.empty(0), np.empty(0)
+    min_gap = 0.3 * per
+    keep = [zc[0]]
+    for z in zc[1:]:
+        if z - keep[-1] >= min_gap:
+            keep.append(z)
+    zc = np.asarray(keep)
+    u = np.arange(-h, h + 1, dtype=float)
+    V = np.vstack([np.ones_like(u), u, u * u]).T
+    pinv = np.linalg.pinv(V)
+    tk, vk = [], []
+    for a, b in zip(zc[:-1], zc[1:]):
+        seg = y[a + 1:b + 1]
+        if seg.size == 0:
+            continue
+        i = a + 1 + int(np.argmax(np.abs(seg)))
+        if i - h < 0 or i + h >= y.size:
+            continue
+        c0, c1, c2 = pinv @ x[i - h:i + h + 1]
+        if c2 == 0:
+            continue
+        du = -c1 / (2 * c2)
+        if abs(du) > h:
+            continue
+        tk.append((i + du) / fs)
+        vk.append(c0 - c1 * c1 / (4 * c2))
+    tk, vk = np.asarray(tk), np.asarray(vk)
+    if tk.size < 2:
+        return np.empty(0), np.empty(0)
+    # pair each extreme with the next one of opposite sign (about half a cycle later)
+    amp = 0.5 * np.abs(vk[1:] - vk[:-1])
+    tm = 0.5 * (tk[1:] + tk[:-1])
+    ok = np.sign(vk[1:] - base_at(base, tk[1:], fs)) != np.sign(vk[:-1] - base_at(base, tk[:-1], fs))
+    return tm[ok], amp[ok]
+
+
+def base_at(base: np.ndarray, t: np.ndarray, fs: float) -> np.ndarray:
+    i = np.clip(np.round(t * fs).astype(int), 0, base.size - 1)
+    return base[i]
+
+
+def spectral_peak(x: np.ndarray, fs: float, band=None) -> float:
+    """Frequency of the strongest spectral line (zero-padded, Hann), optionally inside a band."""
+    n = x.size
+    nfft = int(2 ** np.ceil(np.log2(max(4 * n, 1024))))
+    X = np.abs(np.fft.rfft((x - x.mean()) * np.hanning(n), nfft))
+    f = np.fft.rfftfreq(nfft, 1 / fs)
+    sel = np.ones_like(f, bool) if band is None else (f >= band[0]) & (f <= band[1])
+    sel[0] = False
+    k = np.flatnonzero(sel)[np.argmax(X[sel])]
+    if 0 < k < X.size - 1:
+        a, b, c = np.log(X[k - 1:k + 2] + 1e-300)
+        d = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) != 0 else 0.0
+        return float((k + d) * fs / nfft)
+    return float(f[k])

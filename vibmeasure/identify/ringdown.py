@@ -1,0 +1,561 @@
+"""Free-decay (ring-down) identification by maximum likelihood.
+
+The record after the decay start is modelled as a sum of exponentially damped sinusoids plus
+an offset and a linear drift, in white Gaussian noise:
+
+    x(t) = sum_k exp(-s_k t) (a_k cos(w_k t) + b_k sin(w_k t)) + c0 + c1 t
+
+Least squares is then maximum likelihood. A subspace estimate (ESPRIT on a lagged Hankel
+covariance) gives the start values and the model order; Levenberg-Marquardt on all parameters
+finishes; standard deviations come from the Fisher information at the solution with the noise
+variance estimated from the residual (scaled up where the residual spectrum near a mode is
+stronger than the broadband level). Modes whose damping is not significantly positive are
+stationary tones (mains, machinery) and are kept in the model but not reported as modes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core._validate import as_record, check_band, clean_signal, response_channel
+from ..core.errors import FitError, ParameterError, warn_quality
+from ..core.results import FLAG_TEXT, ModalEstimate
+from ._decay import clipped_mask, cycle_peaks, decay_start
+
+__all__ = ["ringdown", "ringdown_crb"]
+
+DETECT = 50.0          # a mode must carry this many times the per-sample noise variance in energy
+MAX_REL_ZETA_STD = 0.3  # refuse a mode whose zeta is this uncertain (relative std)
+FEW_CYCLES = 5
+MIN_FS_OVER_FN = 10.0
+CHUNK = 1 << 16
+NUM_FLOOR = 1e-9  # relative to the peak: below this, 'noise' is rounding and modes are artefacts
+
+
+# ---------------------------------------------------------------------------------------------
+# subspace start values
+def _esprit(x: np.ndarray, fs: float, max_modes: int, n_modes: int | None):
+    """Continuous-time poles s = -sigma + i w from a lagged-Hankel ESPRIT; also the eigenvalues."""
+    n = x.size
+    y = x - x.mean()
+    X = np.abs(np.fft.rfft(y))
+    f = np.fft.rfftfreq(n, 1 / fs)
+    floor = np.median(X[1:]) + 1e-300
+    sig = np.flatnonzero(X[1:] > 30 * floor) + 1
+    fmax = f[sig].max() if sig.size else fs / 4
+    lag = max(1, int(fs / (3.0 * max(fmax, fs / n))))
+    L = int(min(max(32, 4 * max_modes + 8), 160, max(8, (n - 1) // (3 * lag))))
+    span = (L - 1) * lag
+    if n - span < 2 * L:
+        lag = max(1, (n // 3) // L)
+        span = (L - 1) * lag
+    m = n - span
+    if m < L:
+        raise FitError(f"the decay has {n} samples: too short for identification")
+    q = max(1, m // 60000)  # row stride: bounded work on long records
+    rows = np.lib.stride_tricks.as_strided(y, shape=((m - 1) // q + 1, L),
+                                           strides=(y.strides[0] * q, y.strides[0] * lag))
+    R = rows.T @ rows
+    lam, U = np.linalg.eigh(R)
+    lam, U = lam[::-1], U[:, ::-1]
+    noise_eig = np.median(lam[L // 2:]) + 1e-300 * lam[0]
+    r = int(np.sum(lam > 4.0 * noise_eig))
+    if n_modes is not None:
+        r = max(r, 2 * n_modes)
+    r = int(min(max(r + 1, 2), L - 2, 2 * max_modes + 3))
+    Us = U[:, :r]
+    Phi = np.linalg.lstsq(Us[:-1], Us[1:], rcond=None)[0]
+    z = np.linalg.eigvals(Phi)
+    z = z[np.abs(z) > 1e-12]
+    s = np.log(z) * fs / lag
+    return s
+
+
+def _basis(t, sig, om):
+    e = np.exp(-np.outer(t, sig))
+    return e * np.cos(np.outer(t, om)), e * np.sin(np.outer(t, om))
+
+
+def _linear_amplitudes(x, w, t, sig, om, tn):
+    """Least-squares a_k, b_k and offset/drift for fixed poles; returns (coef, residual rms)."""
+    C, S = _basis(t, sig, om)
+    A = np.column_stack([C, S, np.ones_like(t), tn])
+    coef, *_ = np.linalg.lstsq(A * w[:, None], x * w, rcond=None)
+    res = (x - A @ coef) * w
+    return coef, float(np.sqrt(res @ res / max(w.sum() - A.shape[1], 1)))
+
+
+# ---------------------------------------------------------------------------------------------
+# nonlinear least squares (Levenberg-Marquardt, chunked so memory stays bounded)
+def _evaluate(p, x, w, t, tn, nm, want_model=False):
+    P = p.size
+    JtJ = np.zeros((P, P))
+    Jtr = np.zeros(P)
+    rss = 0.0
+    model_all = np.empty_like(x) if want_model else None
+    for s0 in range(0, x.size, CHUNK):
+        s1 = min(s0 + CHUNK, x.size)
+        tt = t[s0:s1]
+        J = np.empty((s1 - s0, P))
+        model = p[-2] + p[-1] * tn[s0:s1]
+        for k in range(nm):
+            sg, om, a, b = p[4 * k:4 * k + 4]
+            e = np.exp(-sg * tt)
+            c = np.cos(om * tt) * e
+            sn = np.sin(om * tt) * e
+            mk = a * c + b * sn
+            model += mk
+            J[:, 4 * k] = -tt * mk
+            J[:, 4 * k + 1] = tt * (b * c - a * sn)
+            J[:, 4 * k + 2] = c
+            J[:, 4 * k + 3] = sn
+        J[:, -2] = 1.0
+        J[:, -1] = tn[s0:s1]
+        r = x[s0:s1] - model
+        ww = w[s0:s1]
+        if not ww.all():
+            r = r * ww
+            J *= ww[:, None]
+        JtJ += J.T @ J
+        Jtr += J.T @ r
+        rss += float(r @ r)
+        if want_model:
+            model_all[s0:s1] = model
+    return rss, JtJ, Jtr, model_all
+
+
+def _lm(p, x, w, t, tn, nm, max_iter=80):
+    rss, A, g, _ = _evaluate(p, x, w, t, tn, nm)
+    lam = 1e-4
+    for _ in range(max_iter):
+        d = np.sqrt(np.diag(A)) + 1e-300
+        An = A / np.outer(d, d)
+        try:
+            step = np.linalg.solve(An + lam * np.eye(p.size), g / d) / d
+        except np.linalg.LinAlgError:
+            lam *= 10
+            continue
+        pn = p + step
+        if nm:
+            pn[1:4 * nm:4] = np.abs(pn[1:4 * nm:4])
+        rss_n, An_, gn, _ = _evaluate(pn, x, w, t, tn, nm)
+        if np.isfinite(rss_n) and rss_n <= rss:
+            small = True
+            for k in range(nm):
+                om = max(abs(pn[4 * k + 1]), 1e-300)
+                amp = np.hypot(pn[4 * k + 2], pn[4 * k + 3]) + 1e-300
+                small &= abs(step[4 * k]) < 1e-13 * om and abs(step[4 * k + 1]) < 1e-13 * om
+                small &= abs(step[4 * k + 2]) < 1e-11 * amp and abs(step[4 * k + 3]) < 1e-11 * amp
+            gain = rss - rss_n
+            p, rss, A, g = pn, rss_n, An_, gn
+            lam = max(lam / 10, 1e-15)
+            if small or gain <= 1e-15 * rss:
+                break
+        else:
+            lam *= 10
+            if lam > 1e12:
+                break
+    return p, rss, A
+
+
+# ---------------------------------------------------------------------------------------------
+def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | None = None, max_modes: int = 8,
+             fs: float | None = None) -> ModalEstimate:
+    """Natural frequencies and damping ratios from a free decay, by maximum likelihood.
+
+    Parameters
+    ----------
+    rec : Record (or array with ``fs``)
+        The ring-down. With several channels, ``channel`` picks one (default: the first that
+        is not a force); a force channel marks the end of the excitation.
+    n_modes : "auto" or int
+        "auto" keeps every decaying mode that stands out of the noise (up to ``max_modes``);
+        an int keeps that many of the strongest.
+    band : (lo, hi) Hz, optional
+        Report only modes inside this band (the others stay in the model as nuisance).
+    start : float, optional
+        Time (s, from the record's start) where the free decay begins; default: found from the
+        force pulse or the trigger, else the first sample.
+
+    Returns
+    -------
+    ModalEstimate with fn (Hz, undamped), zeta, fn_std, zeta_std, amplitude, phase and flags.
+    ``extras`` holds the noise level, the fitted span, stationary tones and, where found,
+    Coulomb friction and damping versus amplitude.
+
+    Raises
+    ------
+    ParameterError for bad input; FitError when no decaying mode stands out of the noise or
+    every mode's damping is too uncertain (relative std above 0.3).
+    """
+    rec = as_record(rec, fs=fs)
+    idx = response_channel(rec, channel)
+    x_all = clean_signal(rec, idx, min_samples=16)
+    fsr = rec.fs
+    band = check_band(band, fsr)
+    if n_modes != "auto":
+        if isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer)) or n_modes < 1:
+            raise ParameterError(f"n_modes={n_modes!r} must be 'auto' or an integer >= 1")
+        n_modes = int(n_modes)
+        max_modes = max(max_modes, n_modes)
+    else:
+        n_modes = None
+    if isinstance(max_modes, bool) or not isinstance(max_modes, (int, np.integer)) or max_modes < 1:
+        raise ParameterError(f"max_modes={max_modes!r} must be an integer >= 1")
+    flags: list[str] = []
+    notes: list[str] = []
+
+    if start is not None:
+        i0 = int(round(float(start) * fsr))
+        if not 0 <= i0 < x_all.size - 16:
+            raise ParameterError(f"start={start} s is outside the record (0..{rec.duration:g} s)")
+        how = "given"
+    else:
+        i0, how = decay_start(rec, idx, x_all)
+        if i0 > 0:
+            flags.append("start_detected")
+    x = x_all[i0:]
+    clip = clipped_mask(x)
+    if clip.any():
+        flags.append("clipped")
+        notes.append(f"{int(clip.sum())} clipped samples excluded")
+    w = (~clip).astype(float)
+    if w.sum() < 16:
+        raise FitError("almost every sample is clipped: nothing left to fit")
+
+    # --- start values and model order -----------------------------------------------------
+    xs = x.copy()
+    if clip.any():
+        xs[clip] = 0.0
+    try:
+        s = _esprit(xs, fsr, max_modes, n_modes)
+    except np.linalg.LinAlgError as exc:
+        raise FitError(f"subspace start values failed: {exc}") from None
+    osc = s[(s.imag > 2 * np.pi * fsr / x.size * 0.25) & (s.imag < np.pi * fsr * 0.999)]
+    real = s[np.abs(s.imag) <= 2 * np.pi * fsr / x.size * 0.25]
+    sig0 = np.maximum(-osc.real, 1e-6 * osc.imag) if osc.size else np.empty(0)
+    om0 = osc.imag if osc.size else np.empty(0)
+    t = np.arange(x.size) / fsr
+    T = t[-1] if t[-1] > 0 else 1.0
+    tn = t / T - 0.5
+    noise0 = None
+    if om0.size:
+        coef, noise0 = _linear_amplitudes(x, w, t, sig0, om0, tn)
+        noise0 = max(noise0, NUM_FLOOR * float(np.max(np.abs(x))))
+        k = om0.size
+        a, b = coef[:k], coef[k:2 * k]
+        energy = _mode_energy(a, b, sig0, t)
+        strong = np.argsort(-energy)
+        keep = [i for i in strong if energy[i] > DETECT * noise0 ** 2]
+        keep = keep[: (n_modes or max_modes)]
+        sig0, om0, a, b = sig0[keep], om0[keep], a[keep], b[keep]
+    if om0.size == 0:
+        return _overdamped_or_noise(x, w, t, tn, fsr, real, rec, idx, flags)
+
+    # --- trim where the decay has sunk into the noise ---------------------------------------
+    env_amp = np.hypot(a, b)
+    decaying = sig0 > 0
+    n_end = x.size
+    if noise0 and decaying.all():
+        t_floor = np.max(np.log(np.maximum(env_amp / (0.3 * noise0), 1.0)) / sig0)
+        n_end = int(min(x.size, max(np.ceil(t_floor * fsr) + 1, 64)))
+        if n_end < x.size:
+            flags.append("noise_floor")
+    x, w, t = x[:n_end], w[:n_end], t[:n_end]
+    T = t[-1] if t[-1] > 0 else 1.0
+    tn = t / T - 0.5
+
+    # --- maximum likelihood -----------------------------------------------------------------
+    p = _pack(sig0, om0, a, b)
+    for _round in range(4):
+        nm = (p.size - 2) // 4
+        p, rss, A = _lm(p, x, w, t, tn, nm)
+        dof = max(w.sum() - p.size, 1.0)
+        s2 = max(rss / dof, (NUM_FLOOR * float(np.max(np.abs(x)))) ** 2 * 1e-6)
+        energy = _mode_energy(p[2:4 * nm:4], p[3:4 * nm:4], p[0:4 * nm:4], t)
+        weak = energy <= DETECT * s2
+        if not weak.any() or nm == 1:
+            break
+        keep = np.flatnonzero(~weak)
+        if keep.size == 0:
+            break
+        p = np.concatenate([p[4 * k:4 * k + 4] for k in keep] + [p[-2:]])
+    nm = (p.size - 2) // 4
+    try:
+        cov = s2 * np.linalg.inv(A)
+    except np.linalg.LinAlgError:
+        cov = s2 * np.linalg.pinv(A)
+    sig, om = p[0:4 * nm:4], p[1:4 * nm:4]
+    a, b = p[2:4 * nm:4], p[3:4 * nm:4]
+    noise = float(np.sqrt(s2))
+    sig_std = np.sqrt(np.maximum(np.diag(cov)[0:4 * nm:4], 0))
+    _, _, _, model = _evaluate(p, x, w, t, tn, nm, want_model=True)
+    resid = (x - model) * w
+
+    wn = np.hypot(om, sig)
+    fn = wn / (2 * np.pi)
+    zeta = sig / wn
+    fn_std = np.empty(nm)
+    zeta_std = np.empty(nm)
+    for k in range(nm):
+        c2 = cov[4 * k:4 * k + 2, 4 * k:4 * k + 2]
+        g_wn = np.array([sig[k], om[k]]) / wn[k]
+        g_z = np.array([om[k] ** 2, -sig[k] * om[k]]) / wn[k] ** 3
+        fn_std[k] = np.sqrt(max(g_wn @ c2 @ g_wn, 0)) / (2 * np.pi)
+        zeta_std[k] = np.sqrt(max(g_z @ c2 @ g_z, 0))
+    scale = _colored_noise_scale(resid, w, fsr, om / (2 * np.pi), sig / np.pi, noise)
+    fn_std *= scale
+    zeta_std *= scale
+
+    # --- classify, flag, report -------------------------------------------------------------
+    amp = np.hypot(a, b)
+    phase = np.arctan2(-b, a)
+    tones = (sig <= 2 * sig_std) | (sig <= 0)
+    order = np.argsort(fn)
+    report, mode_flags, rejected = [], [], []
+    fd_all = om / (2 * np.pi)
+    for k in order:
+        if tones[k]:
+            continue
+        if band is not None and not band[0] <= fn[k] <= band[1]:
+            continue
+        mf = []
+        if scale[k] > 1:
+            mf.append("colored_noise")
+        t_alive = min(t[-1], np.log(max(amp[k] / max(noise, 1e-300), 1.0)) / sig[k])
+        if fd_all[k] * t_alive < FEW_CYCLES:
+            mf.append("few_cycles")
+        if fsr / fn[k] < MIN_FS_OVER_FN:
+            mf.append("resolution_limited")
+        bw = sig / np.pi  # half-power bandwidth, Hz
+        near = [j for j in range(nm) if j != k and abs(fd_all[j] - fd_all[k]) < max(3 * (bw[k] + bw[j]),
+                                                                                   2.0 / t[-1])]
+        if near:
+            mf.append("close_modes")
+        if "clipped" in flags:
+            mf.append("clipped")
+        if zeta_std[k] > MAX_REL_ZETA_STD * zeta[k]:
+            rejected.append({"fn_hz": fn[k], "zeta": zeta[k], "zeta_std": zeta_std[k]})
+            continue
+        report.append(k)
+        mode_flags.append(mf)
+    if not report:
+        if rejected:
+            r0 = rejected[0]
+            raise FitError(f"damping is too uncertain to report: the mode at {r0['fn_hz']:.6g} Hz has zeta "
+                           f"{r0['zeta']:.3g} +- {r0['zeta_std']:.2g} (relative std above {MAX_REL_ZETA_STD}); "
+                           "record a longer or cleaner decay")
+        if tones.any():
+            raise FitError(f"no decaying mode: only stationary tones at {np.round(fd_all[tones], 4).tolist()} Hz")
+        raise FitError("no decaying mode" + (f" inside band={band}" if band else "") + " stands out of the noise")
+
+    extras = {"noise_std": noise, "start_s": i0 / fsr + rec.t0, "start_found": how,
+              "fit_span_s": float(t[-1]), "n_samples_used": int(w.sum()),
+              "tones_hz": fd_all[tones].tolist(), "channel": rec.channels[idx].name,
+              "rejected_modes": rejected, "notes": notes}
+    ik = np.asarray(report)
+    fn_r, zeta_r = fn[ik].copy(), zeta[ik].copy()
+    fn_std_r, zeta_std_r = fn_std[ik].copy(), zeta_std[ik].copy()
+    # nonlinear damping checks on the strongest mode, isolated from the others
+    kd = ik[int(np.argmax(amp[ik]))]
+    pos = int(np.flatnonzero(ik == kd)[0])
+    iso = x - model + _mode_model(p, kd, t)
+    nl = _nonlinear_damping(iso, fsr, fd_all[kd], noise, t_end=t[-1])
+    if nl.get("coulomb"):
+        mode_flags[pos].append("coulomb_friction")
+        fn_r[pos] = fd_all[kd]
+        zeta_r[pos] = np.nan
+        zeta_std_r[pos] = np.nan
+        extras["friction_decay_per_cycle"] = nl["decay_per_cycle"]
+        extras["friction_decay_per_cycle_std"] = nl["decay_per_cycle_std"]
+        extras["friction_displacement"] = nl["decay_per_cycle"] / 4.0
+    if nl.get("amplitude_dependent"):
+        mode_flags[pos].append("amplitude_dependent")
+    if "zeta_vs_amplitude" in nl:
+        extras["zeta_vs_amplitude"] = nl["zeta_vs_amplitude"]
+    est = ModalEstimate(fn=fn_r, zeta=zeta_r, fn_std=fn_std_r, zeta_std=zeta_std_r, method="ml",
+                        flags=tuple(flags), mode_flags=tuple(tuple(m) for m in mode_flags), amplitude=amp[ik],
+                        phase=phase[ik], unit=rec.channels[idx].unit, extras=extras)
+    _warn_flags(est, rejected)
+    return est
+
+
+def _pack(sig, om, a, b):
+    p = np.empty(4 * sig.size + 2)
+    p[0:-2:4], p[1:-2:4], p[2:-2:4], p[3:-2:4] = sig, om, a, b
+    p[-2:] = 0.0
+    return p
+
+
+def _mode_model(p, k, t):
+    sg, om, a, b = p[4 * k:4 * k + 4]
+    e = np.exp(-sg * t)
+    return e * (a * np.cos(om * t) + b * np.sin(om * t))
+
+
+def _mode_energy(a, b, sig, t):
+    """Energy sum over samples of each mode's contribution (about A^2/2 per sample)."""
+    n = t.size
+    fs = (n - 1) / t[-1] if t[-1] > 0 else 1.0
+    out = np.empty(a.size)
+    for k in range(a.size):
+        A2 = a[k] ** 2 + b[k] ** 2
+        s = sig[k]
+        if s * t[-1] < 1e-9:
+            out[k] = 0.5 * A2 * n
+        else:
+            out[k] = 0.5 * A2 * fs * (1 - np.exp(-2 * s * t[-1])) / (2 * s)
+    return out
+
+
+def _colored_noise_scale(resid, w, fs, fd, bw, noise):
+    """Per mode: sqrt(local residual PSD / white level) where it clearly exceeds 1, else 1."""
+    from scipy.signal import welch
+    n = int(w.sum())
+    scale = np.ones(fd.size)
+    if n < 256 or noise <= 0:
+        return scale
+    nper = int(min(4096, 2 ** int(np.log2(n // 8))))
+    f, pxx = welch(resid, fs=fs, nperseg=nper)
+    white = 2 * noise ** 2 / fs
+    df = f[1] - f[0]
+    for k in range(fd.size):
+        half = max(5 * bw[k], 3 * df)
+        sel = (f >= fd[k] - half) & (f <= fd[k] + half)
+        nb = int(sel.sum())
+        if nb < 2:
+            continue
+        ratio = float(pxx[sel].mean() / white)
+        # the band mean of nb Welch bins scatters by about 1/sqrt(nb * segments)
+        segs = max(1, 2 * n // nper - 1)
+        if ratio > 1 + 4 / np.sqrt(nb * segs):
+            scale[k] = np.sqrt(ratio)
+    return scale
+
+
+def _nonlinear_damping(x, fs, fd, noise, t_end):
+    """Coulomb (linear envelope) and amplitude-dependent damping from the cycle amplitudes."""
+    out: dict = {}
+    tp, ap = cycle_peaks(x, fs, fd)
+    ok = ap > 10 * noise
+    tp, ap = tp[ok], ap[ok]
+    if tp.size < 8:
+        return out
+    # exponential vs linear envelope, both fitted to the amplitudes themselves
+    lin = np.polyfit(tp, ap, 1)
+    r_lin = ap - np.polyval(lin, tp)
+    wts = ap  # log fit weighted by amplitude: least squares on the amplitudes to first order
+    ex = np.polyfit(tp, np.log(ap), 1, w=wts)
+    r_exp = ap - np.exp(np.polyval(ex, tp))
+    rss_lin, rss_exp = float(r_lin @ r_lin), float(r_exp @ r_exp)
+    if lin[0] < 0 and rss_lin < 0.2 * rss_exp:
+        slope_std = np.sqrt(rss_lin / max(tp.size - 2, 1) / np.sum((tp - tp.mean()) ** 2))
+        out["coulomb"] = True
+        out["decay_per_cycle"] = float(-lin[0] / fd)
+        out["decay_per_cycle_std"] = float(slope_std / fd)
+        return out
+    # local damping over groups of cycles
+    g = max(3, tp.size // 8)
+    rows = []
+    for i in range(0, tp.size - g + 1, g):
+        tt, aa = tp[i:i + g], ap[i:i + g]
+        sl = np.polyfit(tt, np.log(aa), 1)[0]
+        delta = -sl / fd
+        rows.append((float(np.exp(np.mean(np.log(aa)))), float(delta / np.sqrt(4 * np.pi ** 2 + delta ** 2))))
+    if len(rows) >= 3:
+        amp_g = np.array([r[0] for r in rows])
+        z_g = np.array([r[1] for r in rows])
+        out["zeta_vs_amplitude"] = [{"amplitude": a_, "zeta": z_} for a_, z_ in rows]
+        X = np.log(amp_g)
+        if np.ptp(X) > 0:
+            c = np.polyfit(X, z_g, 1)
+            res = z_g - np.polyval(c, X)
+            se = np.sqrt(res @ res / max(len(rows) - 2, 1) / np.sum((X - X.mean()) ** 2)) + 1e-300
+            change = abs(c[0]) * np.ptp(X) / max(np.mean(np.abs(z_g)), 1e-300)
+            if abs(c[0]) / se > 4 and change > 0.2:
+                out["amplitude_dependent"] = True
+    return out
+
+
+def _overdamped_or_noise(x, w, t, tn, fs, real_poles, rec, idx, flags):
+    """No oscillating mode: fit two decaying exponentials (over-damped SDOF) or refuse."""
+    from scipy.optimize import least_squares
+    rates = np.sort(-real_poles.real[real_poles.real < 0])
+    y = x - np.median(x[-max(8, x.size // 10):])
+    e0 = float(np.sum(y[:max(8, x.size // 10)] ** 2))
+    noise = float(np.std(np.diff(x[-max(16, x.size // 5):])) / np.sqrt(2))
+    if rates.size == 0 or e0 < DETECT * noise ** 2 * max(8, x.size // 10) * 0.1 or abs(y[0]) < 20 * noise:
+        raise FitError("no decaying mode stands out of the noise (the record looks like noise or a constant "
+                       "with noise)")
+    r1 = rates[0]
+    r2 = rates[1] if rates.size > 1 else 10 * r1
+    def fun(q):
+        e1, e2 = np.exp(-np.exp(q[0]) * t), np.exp(-np.exp(q[1]) * t)
+        A = np.column_stack([e1, e2, np.ones_like(t)])
+        c, *_ = np.linalg.lstsq(A * w[:, None], x * w, rcond=None)
+        return (x - A @ c) * w
+    sol = least_squares(fun, np.log([r1, r2]), method="lm")
+    ra, rb = np.sort(np.exp(sol.x))
+    if not np.isfinite(ra * rb) or abs(rb - ra) < 1e-9 * rb:
+        raise FitError("no oscillation and no resolvable pair of decay rates: cannot tell the damping")
+    wn = np.sqrt(ra * rb)
+    zeta = (ra + rb) / (2 * wn)
+    J = sol.jac
+    s2 = float(sol.fun @ sol.fun) / max(w.sum() - 5, 1)
+    try:
+        cov = s2 * np.linalg.inv(J.T @ J)
+        # zeta = cosh((ln rb - ln ra)/2) in the log-rate parameters
+        u = 0.5 * (np.log(rb) - np.log(ra))
+        g = np.array([-0.5, 0.5]) * np.sinh(u) * np.sign(sol.x[1] - sol.x[0])
+        zstd = float(np.sqrt(max(g @ cov @ g, 0)))
+    except np.linalg.LinAlgError:
+        zstd = np.nan
+    est = ModalEstimate(fn=[np.nan], zeta=[zeta], fn_std=[np.nan], zeta_std=[zstd], method="ml",
+                        flags=tuple(flags) + ("overdamped",), unit=rec.channels[idx].unit,
+                        extras={"decay_rates_per_s": [ra, rb], "wn_rad_s": wn, "channel": rec.channels[idx].name})
+    warn_quality(f"overdamped: no oscillation in the record; zeta = {zeta:.3g} from two decay rates "
+                 f"({ra:.4g}, {rb:.4g} 1/s), no natural frequency is reported", stacklevel=3)
+    return est
+
+
+def _warn_flags(est: ModalEstimate, rejected):
+    serious = [f for f in est.flags if f not in ("noise_floor", "start_detected")]
+    msgs = [f"{f}: {FLAG_TEXT.get(f, f)}" for f in serious]
+    if rejected:
+        msgs.append(f"{len(rejected)} mode(s) left out: damping relative std above {MAX_REL_ZETA_STD}")
+    if msgs:
+        warn_quality("ringdown: " + "; ".join(msgs), stacklevel=4)
+
+
+def ringdown_crb(*, fn: float, zeta: float, fs: float, duration: float, amplitude: float = 1.0,
+                 phase: float = 0.0, noise_std: float | None = None, snr_db: float | None = None) -> dict:
+    """Cramer-Rao bound on fn and zeta for one damped sinusoid in white Gaussian noise.
+
+    The signal is ``amplitude * exp(-zeta wn t) cos(wd t + phase)`` sampled at ``fs`` for
+    ``duration`` s; the noise std is given, or follows from ``snr_db`` = 10 log10(A^2 / (2 s^2)).
+    The bound is the inverse Fisher information of (sigma, wd, a, b), mapped to fn and zeta.
+    Use it to plan a test: the std any unbiased estimator can reach.
+    Returns dict with fn_std, zeta_std (and fn, zeta).
+    """
+    from ..core._validate import positive
+    fn, fs, duration = positive(fn, "fn"), positive(fs, "fs"), positive(duration, "duration")
+    if not 0 < zeta < 1:
+        raise ParameterError(f"zeta={zeta} must be in (0, 1) for an oscillating decay")
+    if (noise_std is None) == (snr_db is None):
+        raise ParameterError("give exactly one of noise_std and snr_db")
+    s = noise_std if noise_std is not None else abs(amplitude) / np.sqrt(2 * 10 ** (snr_db / 10))
+    s = positive(s, "noise_std")
+    wn = 2 * np.pi * fn
+    sig, om = zeta * wn, wn * np.sqrt(1 - zeta ** 2)
+    t = np.arange(int(round(duration * fs))) / fs
+    a, b = amplitude * np.cos(phase), -amplitude * np.sin(phase)
+    e = np.exp(-sig * t)
+    c, sn = e * np.cos(om * t), e * np.sin(om * t)
+    m = a * c + b * sn
+    J = np.column_stack([-t * m, t * (b * c - a * sn), c, sn])
+    cov = s ** 2 * np.linalg.inv(J.T @ J)
+    c2 = cov[:2, :2]
+    g_wn = np.array([sig, om]) / wn
+    g_z = np.array([om ** 2, -sig * om]) / wn ** 3
+    return {"fn": fn, "zeta": zeta, "fn_std": float(np.sqrt(g_wn @ c2 @ g_wn) / (2 * np.pi)),
+            "zeta_std": float(np.sqrt(g_z @ c2 @ g_z)), "noise_std": float(s)}
