@@ -121,6 +121,38 @@ def free_decay(*, fn, zeta, fs: float, duration: float, amplitude=1.0, phase=0.0
                    ref_amp=max(env), clip=clip, dc_offset=dc_offset, drift=drift, seed=seed, name=name, truth=truth)
 
 
+def coulomb_response(t, *, fn: float, friction_decay: float, amplitude: float, order: int = 0) -> np.ndarray:
+    """Closed-form dry-friction decay released from rest at ``amplitude`` at t = 0 (t >= 0).
+
+    Each half cycle is a cosine about a centre shifted by the friction displacement mu = F/k
+    (= friction_decay / 4) against the motion; the turning amplitude falls by 2 mu per half cycle
+    until it is below mu and the mass sticks. ``order`` 1 and 2 give velocity and acceleration.
+    """
+    t = np.asarray(t, dtype=float)
+    mu = friction_decay / 4.0
+    wn = 2 * np.pi * fn
+    half = np.pi / wn
+    x = np.zeros_like(t)
+    a, side = abs(float(amplitude)), (1.0 if amplitude >= 0 else -1.0)
+    k = np.floor(np.maximum(t, 0.0) / half).astype(int)
+    n_half = int(k.max()) + 1 if t.size else 0
+    for j in range(n_half):
+        r = a - mu  # amplitude about the shifted centre
+        seg = k == j
+        if r <= 0:  # stuck: friction holds the mass where it turned
+            x[k >= j] = side * a if order == 0 else 0.0
+            break
+        tau = t[seg] - j * half
+        if order == 0:
+            x[seg] = side * (mu + r * np.cos(wn * tau))
+        elif order == 1:
+            x[seg] = -side * r * wn * np.sin(wn * tau)
+        else:
+            x[seg] = -side * r * wn ** 2 * np.cos(wn * tau)
+        a, side = r - mu, -side
+    return x
+
+
 def coulomb_decay(*, fn: float, friction_decay: float, fs: float, duration: float, amplitude: float = 1.0,
                   quantity: str = "displacement", unit: str | None = None, snr_db: float | None = None,
                   noise_std: float | None = None, seed=None, name: str = "x") -> Record:
@@ -135,33 +167,11 @@ def coulomb_decay(*, fn: float, friction_decay: float, fs: float, duration: floa
     dec = positive(friction_decay, "friction_decay")
     if quantity not in _ORDER:
         raise ParameterError(f"quantity={quantity!r} must be one of {tuple(_ORDER)}")
-    mu = dec / 4.0  # friction displacement F/k
-    wn = 2 * np.pi * fn
     n = int(round(duration * fs))
     t = np.arange(n) / fs
+    x = coulomb_response(t, fn=fn, friction_decay=dec, amplitude=float(amplitude), order=_ORDER[quantity])
+    wn = 2 * np.pi * fn
     order = _ORDER[quantity]
-    x = np.zeros(n)
-    half = np.pi / wn
-    a, center, t_start = float(amplitude), mu, 0.0  # released at +A moving down: centre at +mu
-    while True:
-        r = a - mu  # amplitude about the shifted centre
-        seg = (t >= t_start) & (t < t_start + half)
-        if r <= 0:  # stuck: friction holds the mass where it turned
-            x[t >= t_start] = np.sign(center) * a if order == 0 else 0.0
-            break
-        tau = t[seg] - t_start
-        sgn = 1.0 if center > 0 else -1.0  # +: moving from +A down, -: moving from -A up
-        if order == 0:
-            x[seg] = center + sgn * r * np.cos(wn * tau)
-        elif order == 1:
-            x[seg] = -sgn * r * wn * np.sin(wn * tau)
-        else:
-            x[seg] = -sgn * r * wn ** 2 * np.cos(wn * tau)
-        t_start += half
-        a = r - mu  # next turning point magnitude: |centre - r|
-        center = -center
-        if t_start >= t[-1]:
-            break
     truth = {"kind": "coulomb_decay", "fn": fn, "friction_decay": dec, "amplitude": float(amplitude),
              "quantity": quantity}
     return _finish(x, t, fs=fs, quantity=quantity, unit=unit, snr_db=snr_db, noise_std=noise_std,

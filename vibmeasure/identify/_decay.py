@@ -59,9 +59,15 @@ def decay_start(rec: Record, idx: int, x: np.ndarray) -> tuple[int, str]:
     nblk = x.size // nb
     if nblk < 4:
         return 0, "start"
-    blocks = x[: nblk * nb].reshape(nblk, nb)
-    rms = blocks.std(axis=1)
+    blocks = x[: nblk * nb].reshape(nblk, nb) - np.median(x)
+    rms = np.sqrt(np.mean(blocks ** 2, axis=1))
     if rms[0] >= 0.25 * rms.max():
+        # an impulsive start (rising from near zero to the peak within the first block) is an
+        # impact response: the free decay begins at the peak, after the excitation
+        y = np.abs(x - np.median(x))
+        ip = int(np.argmax(y))
+        if 0 < ip < nb and y[0] < 0.2 * y[ip]:
+            return ip, "after impact peak"
         return 0, "start"
     j = int(np.argmax(rms > 0.5 * rms.max()))
     seg = np.abs(x[j * nb:(j + 2) * nb] - np.median(x[: max(nb, j * nb)]))

@@ -20,7 +20,7 @@ import numpy as np
 from ..core._validate import as_record, check_band, clean_signal, response_channel
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import FLAG_TEXT, ModalEstimate
-from ._decay import clipped_mask, cycle_peaks, decay_start
+from ._decay import clipped_mask, cycle_peaks, decay_start, noise_std, spectral_peak
 
 __all__ = ["ringdown", "ringdown_crb"]
 
@@ -69,6 +69,35 @@ def _esprit(x: np.ndarray, fs: float, max_modes: int, n_modes: int | None):
     z = z[np.abs(z) > 1e-12]
     s = np.log(z) * fs / lag
     return s
+
+
+def _spectral_candidates(x, fs, n_max):
+    """Poles from the strongest peaks of the zero-padded spectrum (half-power width -> decay rate).
+
+    They complement the subspace poles: the lagged Hankel spans a short time, so a weak-looking
+    but long-lived low-frequency mode may be missing from its leading subspace.
+    """
+    from scipy.signal import find_peaks
+    n = x.size
+    nfft = int(2 ** np.ceil(np.log2(4 * n)))
+    P = np.abs(np.fft.rfft(x - x.mean(), nfft)) ** 2
+    df = fs / nfft
+    floor = np.median(P) + 1e-300
+    pk, _ = find_peaks(P, height=100 * floor, distance=max(1, int(4 * nfft / n)))
+    pk = pk[np.argsort(-P[pk])][:n_max]
+    out = []
+    for k in pk:
+        if k < 2 or k > P.size - 3:
+            continue
+        half = P[k] / 2
+        lo, hi = k, k
+        while lo > 0 and P[lo] > half:
+            lo -= 1
+        while hi < P.size - 1 and P[hi] > half:
+            hi += 1
+        sigma = max(np.pi * (hi - lo) * df, np.pi * fs / n)
+        out.append(complex(-sigma, 2 * np.pi * k * df))
+    return np.asarray(out)
 
 
 def _basis(t, sig, om):
@@ -125,6 +154,12 @@ def _evaluate(p, x, w, t, tn, nm, want_model=False):
 
 
 def _lm(p, x, w, t, tn, nm, max_iter=80):
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _lm_inner(p, x, w, t, tn, nm, max_iter)
+
+
+def _lm_inner(p, x, w, t, tn, nm, max_iter):
+    sig_min = -1.0 / max(t[-1], 1e-300)  # a mode may grow at most e-fold over the record
     rss, A, g, _ = _evaluate(p, x, w, t, tn, nm)
     lam = 1e-4
     for _ in range(max_iter):
@@ -138,8 +173,9 @@ def _lm(p, x, w, t, tn, nm, max_iter=80):
         pn = p + step
         if nm:
             pn[1:4 * nm:4] = np.abs(pn[1:4 * nm:4])
+            pn[0:4 * nm:4] = np.maximum(pn[0:4 * nm:4], sig_min)
         rss_n, An_, gn, _ = _evaluate(pn, x, w, t, tn, nm)
-        if np.isfinite(rss_n) and rss_n <= rss:
+        if np.isfinite(rss_n) and np.all(np.isfinite(gn)) and rss_n <= rss:
             small = True
             for k in range(nm):
                 om = max(abs(pn[4 * k + 1]), 1e-300)
@@ -223,6 +259,12 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     if w.sum() < 16:
         raise FitError("almost every sample is clipped: nothing left to fit")
 
+    # --- dry friction: a linear envelope is not a sum of damped sinusoids --------------------
+    if (~clip).all():
+        coul = _coulomb_check(x, fsr, rec, idx, flags, i0, how)
+        if coul is not None:
+            return coul
+
     # --- start values and model order -----------------------------------------------------
     xs = x.copy()
     if clip.any():
@@ -232,6 +274,11 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     except np.linalg.LinAlgError as exc:
         raise FitError(f"subspace start values failed: {exc}") from None
     osc = s[(s.imag > 2 * np.pi * fsr / x.size * 0.25) & (s.imag < np.pi * fsr * 0.999)]
+    spec = _spectral_candidates(xs, fsr, max_modes)
+    if spec.size:
+        res_w = 2 * np.pi * 2 * fsr / x.size  # two bins of the unpadded spectrum
+        new = [c for c in spec if not osc.size or np.min(np.abs(osc.imag - c.imag)) > max(res_w, -c.real)]
+        osc = np.concatenate([osc, np.asarray(new, dtype=complex)])
     real = s[np.abs(s.imag) <= 2 * np.pi * fsr / x.size * 0.25]
     sig0 = np.maximum(-osc.real, 1e-6 * osc.imag) if osc.size else np.empty(0)
     om0 = osc.imag if osc.size else np.empty(0)
@@ -245,9 +292,13 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         k = om0.size
         a, b = coef[:k], coef[k:2 * k]
         energy = _mode_energy(a, b, sig0, t)
-        strong = np.argsort(-energy)
-        keep = [i for i in strong if energy[i] > DETECT * noise0 ** 2]
-        keep = keep[: (n_modes or max_modes)]
+        strong = [i for i in np.argsort(-energy) if energy[i] > DETECT * noise0 ** 2]
+        if band is None:
+            keep = strong[: (n_modes or max_modes)]
+        else:  # the band's modes first, then the strongest others as nuisance
+            fk = np.hypot(om0, sig0) / (2 * np.pi)
+            inb = [i for i in strong if band[0] <= fk[i] <= band[1]][: (n_modes or max_modes)]
+            keep = inb + [i for i in strong if i not in inb][: max(0, max_modes - len(inb))]
         sig0, om0, a, b = sig0[keep], om0[keep], a[keep], b[keep]
     if om0.size == 0:
         return _overdamped_or_noise(x, w, t, tn, fsr, real, rec, idx, flags)
@@ -311,11 +362,20 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     amp = np.hypot(a, b)
     phase = np.arctan2(-b, a)
     tones = (sig <= 2 * sig_std) | (sig <= 0)
+    # nuisance components stay in the model but are not modes: baseline wander (under two cycles
+    # in the fitted span) and short transients (under 1.5 cycles above the noise) beside a
+    # stronger mode
+    alive = np.minimum(t[-1], np.log(np.maximum(np.hypot(a, b) / max(noise, 1e-300), 1.0))
+                       / np.maximum(sig, 1e-300))
+    e_fit = _mode_energy(a, b, sig, t)
+    wander = om / (2 * np.pi) * t[-1] < 2
+    transient = (om / (2 * np.pi) * alive < 1.5) & (e_fit < e_fit.max())
+    nuisance = (wander | transient) & ~tones
     order = np.argsort(fn)
     report, mode_flags, rejected = [], [], []
     fd_all = om / (2 * np.pi)
     for k in order:
-        if tones[k]:
+        if tones[k] or nuisance[k]:
             continue
         if band is not None and not band[0] <= fn[k] <= band[1]:
             continue
@@ -345,13 +405,17 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
             raise FitError(f"damping is too uncertain to report: the mode at {r0['fn_hz']:.6g} Hz has zeta "
                            f"{r0['zeta']:.3g} +- {r0['zeta_std']:.2g} (relative std above {MAX_REL_ZETA_STD}); "
                            "record a longer or cleaner decay")
-        if tones.any():
+        if (tones | nuisance).any() and not rejected:
+            if not tones.any():
+                raise FitError("no decaying mode: only baseline wander or short transients stand out of the noise")
             raise FitError(f"no decaying mode: only stationary tones at {np.round(fd_all[tones], 4).tolist()} Hz")
         raise FitError("no decaying mode" + (f" inside band={band}" if band else "") + " stands out of the noise")
 
     extras = {"noise_std": noise, "start_s": i0 / fsr + rec.t0, "start_found": how,
               "fit_span_s": float(t[-1]), "n_samples_used": int(w.sum()),
               "tones_hz": fd_all[tones].tolist(), "channel": rec.channels[idx].name,
+              "nuisance": [{"fn_hz": fn[k], "zeta": zeta[k], "why": "baseline wander" if wander[k] else "transient"}
+                           for k in np.flatnonzero(nuisance)],
               "rejected_modes": rejected, "notes": notes}
     ik = np.asarray(report)
     fn_r, zeta_r = fn[ik].copy(), zeta[ik].copy()
@@ -451,6 +515,7 @@ def _nonlinear_damping(x, fs, fd, noise, t_end):
     if lin[0] < 0 and rss_lin < 0.2 * rss_exp:
         slope_std = np.sqrt(rss_lin / max(tp.size - 2, 1) / np.sum((tp - tp.mean()) ** 2))
         out["coulomb"] = True
+        out["peak_times"] = tp
         out["decay_per_cycle"] = float(-lin[0] / fd)
         out["decay_per_cycle_std"] = float(slope_std / fd)
         return out
@@ -475,6 +540,51 @@ def _nonlinear_damping(x, fs, fd, noise, t_end):
             if abs(c[0]) / se > 4 and change > 0.2:
                 out["amplitude_dependent"] = True
     return out
+
+
+def _coulomb_check(x, fs, rec, idx, flags, i0, how):
+    """A single-mode decay whose cycle amplitudes fall linearly: report Coulomb friction."""
+    fd0 = spectral_peak(x, fs)
+    nl = _nonlinear_damping(x, fs, fd0, noise_std(x, fs), t_end=x.size / fs)
+    if not nl.get("coulomb"):
+        return None
+    tp = nl["peak_times"]
+    k = np.round((tp - tp[0]) * fd0 * 2)  # half-cycle numbers (peak and trough pairs)
+    half, icpt = np.polyfit(k, tp, 1)
+    # maximum likelihood on the closed-form dry-friction response, released at the first turning
+    # point: frequency, friction decay, amplitude, release time and offset
+    from scipy.optimize import least_squares
+    from ..synth import coulomb_response
+    te0 = icpt - half / 2
+    i_a = max(0, int(np.ceil(te0 * fs)))
+    t = np.arange(x.size) / fs
+    a0 = float(np.interp(te0, t, x) - np.median(x[-max(8, x.size // 10):]))
+    q0 = np.array([1 / (2 * half), nl["decay_per_cycle"], a0, te0, float(np.median(x[-max(8, x.size // 10):]))])
+
+    def resid(q):
+        return x[i_a:] - (q[4] + coulomb_response(t[i_a:] - q[3], fn=q[0], friction_decay=abs(q[1]), amplitude=q[2]))
+    sol = least_squares(resid, q0, x_scale=np.abs(q0) + [0, 0, 0, half, abs(a0)], method="lm")
+    q = sol.x
+    s2 = float(sol.fun @ sol.fun) / max(sol.fun.size - q.size, 1)
+    try:
+        cov = s2 * np.linalg.inv(sol.jac.T @ sol.jac)
+        fn, fn_std = float(q[0]), float(np.sqrt(cov[0, 0]))
+        dec, dec_std = float(abs(q[1])), float(np.sqrt(cov[1, 1]))
+    except np.linalg.LinAlgError:
+        fn, fn_std, dec, dec_std = 1 / (2 * half), np.nan, nl["decay_per_cycle"], nl["decay_per_cycle_std"]
+    nl = dict(nl, decay_per_cycle=dec, decay_per_cycle_std=dec_std)
+    extras = {"friction_decay_per_cycle": nl["decay_per_cycle"],
+              "friction_decay_per_cycle_std": nl["decay_per_cycle_std"],
+              "friction_displacement": nl["decay_per_cycle"] / 4.0, "start_s": i0 / fs + rec.t0,
+              "start_found": how, "channel": rec.channels[idx].name,
+              "stop_s": float(tp[-1] + rec.t0 + i0 / fs)}
+    est = ModalEstimate(fn=[fn], zeta=[np.nan], fn_std=[fn_std], zeta_std=[np.nan], method="ml",
+                        flags=tuple(flags), mode_flags=(("coulomb_friction",),), unit=rec.channels[idx].unit,
+                        extras=extras)
+    warn_quality(f"ringdown: dry (Coulomb) friction: the amplitude falls linearly by "
+                 f"{nl['decay_per_cycle']:.4g} {rec.channels[idx].unit} per cycle; no viscous zeta is reported",
+                 stacklevel=4)
+    return est
 
 
 def _overdamped_or_noise(x, w, t, tn, fs, real_poles, rec, idx, flags):
