@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import struct
 import warnings
 
 import numpy as np
@@ -20,7 +21,7 @@ def read_wav(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
         with warnings.catch_warnings():
             warnings.simplefilter("error", wavfile.WavFileWarning)
             rate, data = wavfile.read(path)
-    except (ValueError, EOFError, OSError, wavfile.WavFileWarning) as exc:
+    except (ValueError, EOFError, OSError, struct.error, wavfile.WavFileWarning) as exc:
         raise ParameterError(f"{src} is unreadable (truncated or not WAV): {exc}") from None
     if fs is not None and float(fs) != float(rate):
         raise ParameterError(f"fs={fs} contradicts {src}, recorded at {rate} Hz")

@@ -1,0 +1,294 @@
+"""File formats: exact round trips, foreign layouts, real recordings and every way a file can be bad."""
+import os
+import struct
+
+import h5py
+import numpy as np
+import pytest
+import scipy.io as sio
+
+import vibmeasure as vm
+
+
+@pytest.fixture
+def rec2(rng):
+    d = rng.normal(size=(2, 500))
+    return vm.Record(d, fs=512.0, channels=[vm.Channel("hammer", "force", "N"),
+                                            vm.Channel("acc1", "acceleration", "m/s^2", "tip")],
+                     t0=0.25, meta={"operator": "test"}, history=("from_array",))
+
+
+# --- CSV --------------------------------------------------------------------------------------
+def test_csv_round_trip_keeps_values_units_and_fs(tmp_path, rec2):
+    p = vm.write(tmp_path / "r.csv", rec2)
+    back = vm.read(p)
+    np.testing.assert_array_equal(back.data, rec2.data)  # %.17g text: exact doubles
+    assert back.fs == rec2.fs and back.t0 == rec2.t0
+    assert [(c.name, c.quantity, c.unit) for c in back.channels] == [("hammer", "force", "N"),
+                                                                      ("acc1", "acceleration", "m/s^2")]
+
+
+def test_csv_time_column_semicolon_decimal_comma(tmp_path):
+    t = np.arange(6) * 0.001
+    rows = ["Zeit [s];Beschl [g]"] + [f"{a:.3f};{b:.4f}".replace(".", ",") for a, b in zip(t, np.sin(t * 900))]
+    p = tmp_path / "de.csv"
+    p.write_text("\n".join(rows) + "\n")
+    r = vm.read(p)
+    assert r.fs == pytest.approx(1000.0, rel=1e-9)
+    assert r.channels[0].unit == "g" and r.channels[0].quantity == "acceleration"
+    np.testing.assert_allclose(r.data[0], np.round(np.sin(t * 900), 4), atol=1e-12)
+
+
+def test_csv_tab_and_fs_header(tmp_path):
+    p = tmp_path / "tab.csv"
+    p.write_text("# fs = 2048\na\tb\n1\t2\n3\t4\n5\t6\n")
+    r = vm.read(p)
+    assert r.fs == 2048.0 and r.names == ["a", "b"]
+    np.testing.assert_array_equal(r.data, [[1, 3, 5], [2, 4, 6]])
+
+
+def test_csv_without_timing_needs_fs(tmp_path):
+    p = tmp_path / "bare.csv"
+    p.write_text("1.0\n2.0\n3.0\n")
+    with pytest.raises(vm.ParameterError, match="fs .sampling rate in Hz. is required"):
+        vm.read(p)
+    assert vm.read(p, fs=100.0).fs == 100.0
+
+
+def test_csv_non_uniform_time_column(tmp_path):
+    p = tmp_path / "jitter.csv"
+    p.write_text("time,x\n0,1\n0.001,2\n0.002,3\n0.0035,4\n0.0045,5\n")
+    with pytest.raises(vm.ParameterError, match="not uniformly sampled.*row 3"):
+        vm.read(p)
+
+
+def test_csv_truncated_and_garbage(tmp_path):
+    p = tmp_path / "trunc.csv"
+    p.write_text("time,a,b\n0,1,2\n0.1,3,4\n0.2,5")
+    with pytest.raises(vm.ParameterError, match="truncated"):
+        vm.read(p)
+    g = tmp_path / "text.csv"
+    g.write_text("time,a\n0,1\n0.1,abc\n")
+    with pytest.raises(vm.ParameterError, match="non-numeric"):
+        vm.read(g)
+
+
+def test_csv_fs_contradiction(tmp_path, rec2):
+    p = vm.write(tmp_path / "r.csv", rec2)
+    with pytest.raises(vm.ParameterError, match="contradicts"):
+        vm.read(p, fs=1000.0)
+
+
+def test_csv_channel_selection(tmp_path, rec2):
+    p = vm.write(tmp_path / "r.csv", rec2)
+    assert vm.read(p, channels=["acc1"]).names == ["acc1"]
+    with pytest.raises(vm.ParameterError, match="'acc9' is not in"):
+        vm.read(p, channels=["acc9"])
+
+
+# --- HDF5 -------------------------------------------------------------------------------------
+def test_hdf5_round_trip_exact_with_schema(tmp_path, rec2):
+    p = vm.write(tmp_path / "r.h5", rec2)
+    assert vm.read(p) == rec2  # data, fs, t0, channels, meta and history all equal
+    with h5py.File(p) as f:
+        assert f.attrs["vibmeasure_schema"] == "vibmeasure.record"
+        assert int(f.attrs["schema_version"]) == 1
+
+
+def test_hdf5_bare_dataset_needs_fs(tmp_path):
+    p = tmp_path / "bare.h5"
+    with h5py.File(p, "w") as f:
+        f["grp/acc"] = np.arange(8.0)
+    with pytest.raises(vm.ParameterError, match="fs .sampling rate in Hz. is required"):
+        vm.read(p, dataset="grp/acc")
+    r = vm.read(p, dataset="grp/acc", fs=50.0, unit="g")
+    assert r.names == ["grp.acc"] and r.channels[0].quantity == "acceleration"
+
+
+def test_hdf5_truncated(tmp_path, rec2):
+    p = vm.write(tmp_path / "r.h5", rec2)
+    data = p.read_bytes()
+    bad = tmp_path / "cut.h5"
+    bad.write_bytes(data[: len(data) // 2])
+    with pytest.raises(vm.ParameterError, match="unreadable|damaged"):
+        vm.read(bad)
+
+
+def test_hdf5_newer_schema_refused(tmp_path, rec2):
+    p = vm.write(tmp_path / "r.h5", rec2)
+    with h5py.File(p, "a") as f:
+        f.attrs["schema_version"] = 99
+    with pytest.raises(vm.ParameterError, match="schema_version 99"):
+        vm.read(p)
+
+
+# --- WAV --------------------------------------------------------------------------------------
+def test_wav_float_round_trip(tmp_path, rec2):
+    p = vm.write(tmp_path / "r.wav", rec2)
+    back = vm.read(p)
+    np.testing.assert_array_equal(back.data, rec2.data)
+    assert back.fs == 512.0
+
+
+def test_wav_int16_full_scale(tmp_path):
+    from scipy.io import wavfile
+    p = tmp_path / "i16.wav"
+    wavfile.write(p, 8000, np.array([0, 16384, -32768, 32767], dtype=np.int16))
+    r = vm.read(p)
+    np.testing.assert_array_equal(r.data[0], [0, 0.5, -1.0, 32767 / 32768])
+    assert r.meta["wav_dtype"] == "int16"
+
+
+def test_wav_truncated(tmp_path, rec2):
+    p = vm.write(tmp_path / "r.wav", rec2)
+    bad = tmp_path / "cut.wav"
+    bad.write_bytes(p.read_bytes()[:30])
+    with pytest.raises(vm.ParameterError, match="unreadable"):
+        vm.read(bad)
+
+
+def test_wav_non_integer_fs_refused(tmp_path):
+    r = vm.Record.from_array(np.zeros(4), fs=100.5)
+    with pytest.raises(vm.ParameterError, match="integer sampling rate"):
+        vm.write(tmp_path / "x.wav", r)
+    assert not list(tmp_path.iterdir())  # nothing half-written
+
+
+# --- MAT --------------------------------------------------------------------------------------
+def test_mat_v5_nested_struct_fields(tmp_path):
+    p = tmp_path / "s.mat"
+    gs = np.sin(np.arange(100) / 5.0)
+    sio.savemat(p, {"bearing": {"gs": gs[:, None], "sr": 2000.0, "rate": 25.0}, "other": np.ones((3, 3))})
+    r = vm.read(p, channels=["bearing.gs"])
+    assert r.names == ["bearing.gs"] and r.fs == 2000.0
+    np.testing.assert_array_equal(r.data[0], gs)
+
+
+def test_mat_time_vector_and_matrix_rows(tmp_path):
+    p = tmp_path / "m.mat"
+    acc = np.vstack([np.arange(50.0), -np.arange(50.0)])
+    sio.savemat(p, {"Fe": {"Out": {"Acc": acc, "Time": (np.arange(50) / 256.0)[None, :]}}})
+    r = vm.read(p)
+    assert r.names == ["Fe.Out.Acc[0]", "Fe.Out.Acc[1]"] and r.fs == pytest.approx(256.0, rel=1e-12)
+    assert vm.read(p, channels=["Fe.Out.Acc[1]"]).data[0, 3] == -3.0
+
+
+def test_mat_v73_through_h5py(tmp_path):
+    # MATLAB v7.3 files are HDF5 with a 512-byte user block; arrays are stored transposed
+    p = tmp_path / "v73.mat"
+    x = np.cos(np.arange(64) / 3.0)
+    with h5py.File(p, "w", userblock_size=512) as f:
+        f.create_dataset("sig", data=x[None, :].T.T)  # MATLAB column vector (64x1) is (1, 64) in HDF5
+        f.create_dataset("fs", data=np.array([[1000.0]]))
+        f["sig"].attrs["MATLAB_class"] = np.bytes_("double")
+    with open(p, "r+b") as fh:
+        fh.write(b"MATLAB 7.3 MAT-file".ljust(116, b" ") + struct.pack("<8x") + b"\x00\x02IM")
+    r = vm.read(p)
+    assert r.fs == 1000.0
+    np.testing.assert_array_equal(r.data[0], x)
+
+
+def test_mat_without_timing_and_truncated(tmp_path):
+    p = tmp_path / "n.mat"
+    sio.savemat(p, {"x": np.arange(10.0)})
+    with pytest.raises(vm.ParameterError, match="fs .sampling rate in Hz. is required"):
+        vm.read(p)
+    bad = tmp_path / "cut.mat"
+    bad.write_bytes(p.read_bytes()[:150])
+    with pytest.raises(vm.ParameterError, match="unreadable|truncated"):
+        vm.read(bad)
+
+
+# --- LVM --------------------------------------------------------------------------------------
+LVM = """LabVIEW Measurement\t
+Writer_Version\t2
+Reader_Version\t2
+Separator\tTab
+Decimal_Separator\t.
+Multi_Headings\tNo
+X_Columns\tOne
+Time_Pref\tRelative
+***End_of_Header***\t
+
+Channels\t2\t
+Samples\t4\t4\t
+Y_Unit_Label\tg\tg\t
+X_Dimension\tTime\tTime\t
+X0\t0.0\t0.0\t
+Delta_X\t0.0005\t0.0005\t
+***End_of_Header***\t\t
+X_Value\tacc_a\tacc_b\tComment
+0.0\t1.5\t-1.5
+0.0005\t2.5\t-2.5
+0.001\t3.5\t-3.5
+0.0015\t4.5\t-4.5
+"""
+
+
+def test_lvm_with_header(tmp_path):
+    p = tmp_path / "h.lvm"
+    p.write_text(LVM)
+    r = vm.read(p)
+    assert r.fs == pytest.approx(2000.0) and r.names == ["acc_a", "acc_b"]
+    assert r.channels[0].unit == "g"
+    np.testing.assert_array_equal(r.data[1], [-1.5, -2.5, -3.5, -4.5])
+
+
+def test_lvm_truncated_header(tmp_path):
+    p = tmp_path / "t.lvm"
+    p.write_text(LVM.split("Channels")[0])
+    with pytest.raises(vm.ParameterError, match="header is incomplete"):
+        vm.read(p)
+
+
+# --- dispatch and writing ---------------------------------------------------------------------
+def test_unknown_missing_empty(tmp_path):
+    with pytest.raises(vm.ParameterError, match="does not exist"):
+        vm.read(tmp_path / "nope.csv")
+    (tmp_path / "x.xyz").write_text("1")
+    with pytest.raises(vm.ParameterError, match="unknown file type"):
+        vm.read(tmp_path / "x.xyz")
+    (tmp_path / "e.csv").write_text("")
+    with pytest.raises(vm.ParameterError, match="empty"):
+        vm.read(tmp_path / "e.csv")
+
+
+def test_failed_write_leaves_nothing(tmp_path, rec2, monkeypatch):
+    import vibmeasure.io.hdf5 as h
+    def boom(*a, **k):
+        raise OSError("disk full")
+    monkeypatch.setattr(h5py.File, "create_dataset", boom)
+    with pytest.raises(OSError):
+        vm.write(tmp_path / "r.h5", rec2)
+    assert os.listdir(tmp_path) == []
+
+
+# --- real recordings (../shared/data) ---------------------------------------------------------
+def test_real_cwru_mat_needs_fs_and_keeps_rpm(shared_data):
+    p = shared_data("cwru/IR007_0.mat")
+    with pytest.raises(vm.ParameterError, match="fs .sampling rate in Hz. is required"):
+        vm.read(p)
+    r = vm.read(p, fs=12000, unit="g", channels=["X105_DE_time"])
+    assert r.n_samples == 121265 and r.meta["rpm"] == 1797.0
+    assert r.channels[0].quantity == "acceleration"
+
+
+def test_real_case1_fs_from_file(shared_data):
+    r = vm.read(shared_data("impact/case1.mat"))
+    assert r.names == ["Time_chan_1", "Time_chan_2"]  # the frequency-domain arrays are not time channels
+    assert r.fs == 1280.0 and r.n_samples == 4096
+
+
+def test_real_dexpilab_struct(shared_data):
+    r = vm.read(shared_data("ringdown/dexpilab1_VDeXpiLab1_Exp.mat"), channels=["Al.Out.Acc"])
+    assert r.names == ["Al.Out.Acc[0]", "Al.Out.Acc[1]"]
+    assert r.fs == pytest.approx(2048.0, rel=1e-9) and r.n_samples == 40960
+
+
+def test_real_lvm_headerless_and_spectrum(shared_data):
+    p = shared_data("ringdown/NIMT_lab1_DanHendata_009.lvm")
+    with pytest.raises(vm.ParameterError, match="fs .sampling rate in Hz. is required"):
+        vm.read(p)
+    assert vm.read(p, fs=10000).n_samples == 250000
+    with pytest.raises(vm.ParameterError, match="holds a spectrum"):
+        vm.read(shared_data("frf/Chowdhury_beam_impulse_FFT_data.lvm"))
