@@ -15,7 +15,11 @@ def clipped_mask(x: np.ndarray) -> np.ndarray:
     """True where a run of CLIP_RUN or more consecutive samples sits at the record's max or min."""
     mask = np.zeros(x.size, bool)
     tol = 1e-12 * max(np.ptp(x), np.finfo(float).tiny)
+    med = np.median(x)
+    reach = np.max(np.abs(x - med))
     for ext in (x.max(), x.min()):
+        if abs(ext - med) < 0.5 * reach:  # a plateau near the resting value is not clipping
+            continue
         at = np.abs(x - ext) <= tol
         if at.sum() < CLIP_RUN:
             continue

@@ -265,10 +265,22 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         if coul is not None:
             return coul
 
+    # --- damping that changes with amplitude: one mode, described by a table ------------------
+    nl_pre = _amplitude_check(x, fsr, band) if (~clip).all() else {}
+    if nl_pre.get("amplitude_dependent") and n_modes is None:
+        # a sum of close 'modes' would mimic the non-exponential envelope: fit one mode instead
+        n_modes = 1
+        if band is None:
+            band = (0.8 * nl_pre["fd"], min(1.2 * nl_pre["fd"], 0.499 * fsr))
+        notes.append("damping changes with amplitude: one mode fitted in "
+                     f"{band[0]:.4g}-{band[1]:.4g} Hz; zeta is an average over the decay")
+
     # --- start values and model order -----------------------------------------------------
-    xs = x.copy()
-    if clip.any():
-        xs[clip] = 0.0
+    # start values from the unclipped tail when the record is clipped at its start
+    c0 = int(np.flatnonzero(clip)[-1]) + 1 if clip.any() else 0
+    if x.size - c0 < 64:
+        raise FitError(f"only {x.size - c0} samples follow the last clipped one: too few to fit a decay")
+    xs = x[c0:]
     try:
         s = _esprit(xs, fsr, max_modes, n_modes)
     except np.linalg.LinAlgError as exc:
@@ -279,7 +291,6 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         res_w = 2 * np.pi * 2 * fsr / x.size  # two bins of the unpadded spectrum
         new = [c for c in spec if not osc.size or np.min(np.abs(osc.imag - c.imag)) > max(res_w, -c.real)]
         osc = np.concatenate([osc, np.asarray(new, dtype=complex)])
-    real = s[np.abs(s.imag) <= 2 * np.pi * fsr / x.size * 0.25]
     sig0 = np.maximum(-osc.real, 1e-6 * osc.imag) if osc.size else np.empty(0)
     om0 = osc.imag if osc.size else np.empty(0)
     t = np.arange(x.size) / fsr
@@ -288,6 +299,11 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     noise0 = None
     if om0.size:
         coef, noise0 = _linear_amplitudes(x, w, t, sig0, om0, tn)
+        if c0:  # amplitudes were referred to the tail's start: refer them to the record's
+            coef2, _ = _linear_amplitudes(x[c0:], w[c0:], t[c0:] - t[c0], sig0, om0, tn[c0:])
+            k = om0.size
+            z = (coef2[:k] - 1j * coef2[k:2 * k]) * np.exp((sig0 - 1j * om0) * t[c0])
+            coef = np.concatenate([z.real, -z.imag, coef[2 * k:]])
         noise0 = max(noise0, NUM_FLOOR * float(np.max(np.abs(x))))
         k = om0.size
         a, b = coef[:k], coef[k:2 * k]
@@ -297,11 +313,15 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
             keep = strong[: (n_modes or max_modes)]
         else:  # the band's modes first, then the strongest others as nuisance
             fk = np.hypot(om0, sig0) / (2 * np.pi)
-            inb = [i for i in strong if band[0] <= fk[i] <= band[1]][: (n_modes or max_modes)]
-            keep = inb + [i for i in strong if i not in inb][: max(0, max_modes - len(inb))]
+            isin = [i for i in strong if band[0] <= fk[i] <= band[1]]
+            inb = isin[: (n_modes or max_modes)]
+            keep = inb + [i for i in strong if i not in isin][: max(0, max_modes - len(inb))]
         sig0, om0, a, b = sig0[keep], om0[keep], a[keep], b[keep]
     if om0.size == 0:
-        return _overdamped_or_noise(x, w, t, tn, fsr, real, rec, idx, flags)
+        od = _overdamped_try(x_all[i0:], fsr, rec, idx, flags)
+        if od is not None:
+            return od
+        raise FitError("no decaying mode stands out of the noise (the record looks like noise)")
 
     # --- trim where the decay has sunk into the noise ---------------------------------------
     env_amp = np.hypot(a, b)
@@ -399,13 +419,27 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
             continue
         report.append(k)
         mode_flags.append(mf)
+    if n_modes is not None and len(report) > n_modes:  # a nuisance pole may have wandered in: keep the strongest
+        e_rep = np.array([e_fit[k] for k in report])
+        top = sorted(np.argsort(-e_rep)[:n_modes])
+        report = [report[j] for j in top]
+        mode_flags = [mode_flags[j] for j in top]
     if not report:
+        od = _overdamped_try(x_all[i0:], fsr, rec, idx, flags)
+        if od is not None:
+            return od
         if rejected:
             r0 = rejected[0]
             raise FitError(f"damping is too uncertain to report: the mode at {r0['fn_hz']:.6g} Hz has zeta "
                            f"{r0['zeta']:.3g} +- {r0['zeta_std']:.2g} (relative std above {MAX_REL_ZETA_STD}); "
                            "record a longer or cleaner decay")
         if (tones | nuisance).any() and not rejected:
+            ks = int(np.argmax(e_fit))
+            if wander[ks]:
+                cyc = fd_all[ks] * t[-1]
+                raise FitError(f"the record is too short: it spans {cyc:.2g} cycles of its strongest component "
+                               f"({fd_all[ks]:.4g} Hz in {t[-1]:.3g} s above the noise); at least 2 cycles are needed "
+                               "(a longer record, or less damping, is needed for fn and zeta)")
             if not tones.any():
                 raise FitError("no decaying mode: only baseline wander or short transients stand out of the noise")
             raise FitError(f"no decaying mode: only stationary tones at {np.round(fd_all[tones], 4).tolist()} Hz")
@@ -433,6 +467,10 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         extras["friction_decay_per_cycle"] = nl["decay_per_cycle"]
         extras["friction_decay_per_cycle_std"] = nl["decay_per_cycle_std"]
         extras["friction_displacement"] = nl["decay_per_cycle"] / 4.0
+    if nl_pre.get("amplitude_dependent"):
+        nl = nl_pre
+        kd_in = [j for j, k in enumerate(ik) if abs(fd_all[k] - nl_pre["fd"]) < 0.2 * nl_pre["fd"]]
+        pos = kd_in[0] if kd_in else pos
     if nl.get("amplitude_dependent"):
         mode_flags[pos].append("amplitude_dependent")
     if "zeta_vs_amplitude" in nl:
@@ -542,6 +580,35 @@ def _nonlinear_damping(x, fs, fd, noise, t_end):
     return out
 
 
+def _amplitude_check(x, fs, band):
+    """Damping versus amplitude from the cycle amplitudes of the dominant (or in-band) mode.
+
+    Runs only where one mode dominates: the band's signal (band-passed, the filter's ringing
+    skipped), or the whole record when 80 % of its energy lies within +-20 % of the strongest line.
+    """
+    from scipy import signal as _sig
+    y = x - np.median(x)
+    if band is not None:
+        lo, hi = band
+        sos = _sig.butter(4, (max(lo, 1e-3 * fs), hi), btype="bandpass", fs=fs, output="sos")
+        y = _sig.sosfiltfilt(sos, y)
+        r_min = float(np.min(-np.log(np.abs(_sig.sos2zpk(sos)[1])))) * fs
+        skip = int(min(y.size // 4, 7 * fs / r_min))
+        y = y[skip:]
+        fd = spectral_peak(y, fs, band)
+    else:
+        fd = spectral_peak(y, fs)
+        P = np.abs(np.fft.rfft(y)) ** 2
+        f = np.fft.rfftfreq(y.size, 1 / fs)
+        near = (f > 0.8 * fd) & (f < 1.2 * fd)
+        if P[near].sum() < 0.8 * P[1:].sum():
+            return {}
+    out = _nonlinear_damping(y, fs, fd, noise_std(y, fs), t_end=y.size / fs)
+    out.pop("coulomb", None)
+    out["fd"] = fd
+    return out
+
+
 def _coulomb_check(x, fs, rec, idx, flags, i0, how):
     """A single-mode decay whose cycle amplitudes fall linearly: report Coulomb friction."""
     fd0 = spectral_peak(x, fs)
@@ -587,44 +654,60 @@ def _coulomb_check(x, fs, rec, idx, flags, i0, how):
     return est
 
 
-def _overdamped_or_noise(x, w, t, tn, fs, real_poles, rec, idx, flags):
-    """No oscillating mode: fit two decaying exponentials (over-damped SDOF) or refuse."""
+def _overdamped_try(x, fs, rec, idx, flags):
+    """No oscillating mode: an over-damped SDOF decays as two real exponentials.
+
+    Accepted when that model (plus an offset) leaves a residual at the noise level and both
+    rates are positive and distinct; otherwise None.
+    """
     from scipy.optimize import least_squares
-    rates = np.sort(-real_poles.real[real_poles.real < 0])
-    y = x - np.median(x[-max(8, x.size // 10):])
-    e0 = float(np.sum(y[:max(8, x.size // 10)] ** 2))
-    noise = float(np.std(np.diff(x[-max(16, x.size // 5):])) / np.sqrt(2))
-    if rates.size == 0 or e0 < DETECT * noise ** 2 * max(8, x.size // 10) * 0.1 or abs(y[0]) < 20 * noise:
-        raise FitError("no decaying mode stands out of the noise (the record looks like noise or a constant "
-                       "with noise)")
-    r1 = rates[0]
-    r2 = rates[1] if rates.size > 1 else 10 * r1
+    n = x.size
+    t = np.arange(n) / fs
+    tail = x[-max(8, n // 10):]
+    y = x - np.median(tail)
+    peak = float(np.max(np.abs(y)))
+    noise = max(noise_std(x, fs), 1e-9 * peak)
+    if peak < 20 * noise:
+        return None
+    # start rates: the slope of ln|y| early and late in the decay
+    big = np.abs(y) > 0.05 * peak
+    if big.sum() < 8:
+        return None
+    t_end = t[np.flatnonzero(big)[-1]]
+    r_slow = max(3.0 / max(t_end, 1e-12), 1e-6)
+
     def fun(q):
         e1, e2 = np.exp(-np.exp(q[0]) * t), np.exp(-np.exp(q[1]) * t)
         A = np.column_stack([e1, e2, np.ones_like(t)])
-        c, *_ = np.linalg.lstsq(A * w[:, None], x * w, rcond=None)
-        return (x - A @ c) * w
-    sol = least_squares(fun, np.log([r1, r2]), method="lm")
+        c, *_ = np.linalg.lstsq(A, x, rcond=None)
+        return x - A @ c
+
+    best = None
+    for ratio in (1.2, 3.0, 10.0, 30.0, 100.0):
+        sol = least_squares(fun, np.log([r_slow, r_slow * ratio]), method="lm", xtol=1e-14, ftol=1e-14)
+        if best is None or sol.cost < best.cost:
+            best = sol
+    sol = best
+    res_rms = float(np.sqrt(2 * sol.cost / max(n - 5, 1)))
     ra, rb = np.sort(np.exp(sol.x))
-    if not np.isfinite(ra * rb) or abs(rb - ra) < 1e-9 * rb:
-        raise FitError("no oscillation and no resolvable pair of decay rates: cannot tell the damping")
+    if not (res_rms < 1.5 * noise and np.isfinite(ra * rb)):
+        return None
     wn = np.sqrt(ra * rb)
     zeta = (ra + rb) / (2 * wn)
-    J = sol.jac
-    s2 = float(sol.fun @ sol.fun) / max(w.sum() - 5, 1)
     try:
-        cov = s2 * np.linalg.inv(J.T @ J)
-        # zeta = cosh((ln rb - ln ra)/2) in the log-rate parameters
-        u = 0.5 * (np.log(rb) - np.log(ra))
+        cov = res_rms ** 2 * np.linalg.inv(sol.jac.T @ sol.jac)
+        # zeta = cosh((ln rb - ln ra) / 2) in the log-rate parameters
+        u = 0.5 * abs(sol.x[1] - sol.x[0])
         g = np.array([-0.5, 0.5]) * np.sinh(u) * np.sign(sol.x[1] - sol.x[0])
         zstd = float(np.sqrt(max(g @ cov @ g, 0)))
     except np.linalg.LinAlgError:
         zstd = np.nan
     est = ModalEstimate(fn=[np.nan], zeta=[zeta], fn_std=[np.nan], zeta_std=[zstd], method="ml",
                         flags=tuple(flags) + ("overdamped",), unit=rec.channels[idx].unit,
-                        extras={"decay_rates_per_s": [ra, rb], "wn_rad_s": wn, "channel": rec.channels[idx].name})
-    warn_quality(f"overdamped: no oscillation in the record; zeta = {zeta:.3g} from two decay rates "
-                 f"({ra:.4g}, {rb:.4g} 1/s), no natural frequency is reported", stacklevel=3)
+                        extras={"decay_rates_per_s": [ra, rb], "wn_rad_s": wn, "channel": rec.channels[idx].name,
+                                "noise_std": noise})
+    warn_quality(f"overdamped: no oscillation in the record; zeta = {zeta:.4g} from two decay rates "
+                 f"({ra:.4g}, {rb:.4g} 1/s), no natural frequency is reported", stacklevel=4)
     return est
 
 
