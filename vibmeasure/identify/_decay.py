@@ -88,6 +88,8 @@ def cycle_peaks(x: np.ndarray, fs: float, fd: float) -> tuple[np.ndarray, np.nda
     Returns (times in s, amplitudes).
     """
     per = fs / fd
+    if not np.isfinite(per) or per > x.size / 3 or per < 2:
+        return np.empty(0), np.empty(0)
     base = uniform_filter1d(x, size=max(3, int(round(per))), mode="nearest")
     y = x - base
     h = max(1, int(round(0.1 * per)))
@@ -137,10 +139,14 @@ def base_at(base: np.ndarray, t: np.ndarray, fs: float) -> np.ndarray:
 
 
 def spectral_peak(x: np.ndarray, fs: float, band=None) -> float:
-    """Frequency of the strongest spectral line (zero-padded, Hann), optionally inside a band."""
+    """Frequency of the strongest spectral line, optionally inside a band (a start value).
+
+    No taper: a decay is its own window, and a Hann taper would hide a decay that is over in
+    the first part of the record.
+    """
     n = x.size
     nfft = int(2 ** np.ceil(np.log2(max(4 * n, 1024))))
-    X = np.abs(np.fft.rfft((x - x.mean()) * np.hanning(n), nfft))
+    X = np.abs(np.fft.rfft(x - x.mean(), nfft))
     f = np.fft.rfftfreq(nfft, 1 / fs)
     sel = np.ones_like(f, bool) if band is None else (f >= band[0]) & (f <= band[1])
     sel[0] = False

@@ -540,6 +540,16 @@ def _nonlinear_damping(x, fs, fd, noise, t_end):
     out: dict = {}
     tp, ap = cycle_peaks(x, fs, fd)
     ok = ap > 10 * noise
+    # only the leading run of regular half cycles: where another component (a leaked neighbour,
+    # noise) takes over, the spacing of the extremes goes astray
+    cut = False
+    if tp.size > 2:
+        dt = np.diff(tp) * 2 * fd  # in half periods; a missed extreme gives 3, a phase jump 1.5
+        bad = np.flatnonzero((np.abs(dt - np.round(dt)) > 0.1) | (np.round(dt) < 1))
+        bad = bad[ok[bad + 1]]
+        if bad.size:
+            ok[bad[0] + 1:] = False
+            cut = True
     tp, ap = tp[ok], ap[ok]
     if tp.size < 8:
         return out
@@ -550,7 +560,13 @@ def _nonlinear_damping(x, fs, fd, noise, t_end):
     ex = np.polyfit(tp, np.log(ap), 1, w=wts)
     r_exp = ap - np.exp(np.polyval(ex, tp))
     rss_lin, rss_exp = float(r_lin @ r_lin), float(r_exp @ r_exp)
-    if lin[0] < 0 and rss_lin < 0.2 * rss_exp:
+    t_zero = -lin[1] / lin[0] if lin[0] < 0 else np.inf
+    after = x[int(min(x.size, np.ceil((t_zero + 1.5 / fd) * fs))):]
+    # dry friction stops the motion: the linear envelope reaches zero just after the last cycle and
+    # the mass then stays put (beating of close modes also looks linear for a while, but goes on)
+    stuck = (not cut and tp[-1] <= t_zero <= tp[-1] + 3 / fd and after.size >= fs / fd
+             and np.std(after) < 3 * noise)
+    if stuck and rss_lin < 0.2 * rss_exp:
         slope_std = np.sqrt(rss_lin / max(tp.size - 2, 1) / np.sum((tp - tp.mean()) ** 2))
         out["coulomb"] = True
         out["peak_times"] = tp
