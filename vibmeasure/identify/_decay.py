@@ -43,7 +43,12 @@ def noise_std(x: np.ndarray, fs: float) -> float:
     k = segs
     med_to_mean = (1 - 2 / (9 * k)) ** 3 if k > 1 else np.log(2)
     level = np.median(p) / med_to_mean
-    return float(np.sqrt(level * fs / 2))
+    welch_std = float(np.sqrt(level * fs / 2))
+    # a record that has decayed ends in noise alone: its last tenth, detrended, is the noise
+    tail = x[-max(16, n // 10):]
+    k = np.arange(tail.size)
+    tail_std = float(np.std(tail - np.polyval(np.polyfit(k, tail, 1), k)))
+    return min(welch_std, tail_std)
 
 
 def decay_start(rec: Record, idx: int, x: np.ndarray) -> tuple[int, str]:
@@ -78,14 +83,26 @@ def decay_start(rec: Record, idx: int, x: np.ndarray) -> tuple[int, str]:
     return j * nb + int(np.argmax(seg)), "after trigger"
 
 
-def cycle_peaks(x: np.ndarray, fs: float, fd: float) -> tuple[np.ndarray, np.ndarray]:
-    """Half-cycle amplitudes of an oscillation at about ``fd`` Hz.
+def baseline_line(x: np.ndarray, fs: float, fd: float) -> np.ndarray:
+    """Offset + drift line under an oscillation, from the midpoints of consecutive extremes.
 
-    The baseline (DC, drift) is a moving average over one period; each half-cycle's extreme is
-    refined by a least-squares parabola over +-0.1 period and paired with the next extreme of
-    opposite sign: amplitude (peak - trough)/2 at the midpoint time. Offsets cancel, and the
-    constant factors from the parabola and the half-cycle decay cancel in any log-slope.
-    Returns (times in s, amplitudes).
+    (v[i-1] + 2 v[i] + v[i+1]) / 4 cancels the oscillation to second order in the decay per half
+    cycle, so a line through these points is the baseline, not the decay's own mean.
+    """
+    tk, vk = extremes(x, fs, fd)
+    t = np.arange(x.size) / fs
+    if tk.size < 5:
+        return np.polyval(np.polyfit(t, x, 1), t)
+    m = 0.25 * (vk[:-2] + 2 * vk[1:-1] + vk[2:])
+    return np.polyval(np.polyfit(tk[1:-1], m, 1), t)
+
+
+def extremes(x: np.ndarray, fs: float, fd: float) -> tuple[np.ndarray, np.ndarray]:
+    """Times (s) and values of the half-cycle extremes of an oscillation at about ``fd`` Hz.
+
+    Extremes are searched between zero crossings of the signal less its one-period moving
+    average (with hysteresis against noise-born crossings) and refined by a least-squares
+    parabola over +-0.1 period.
     """
     per = fs / fd
     if not np.isfinite(per) or per > x.size / 3 or per < 2:
@@ -93,20 +110,16 @@ def cycle_peaks(x: np.ndarray, fs: float, fd: float) -> tuple[np.ndarray, np.nda
     base = uniform_filter1d(x, size=max(3, int(round(per))), mode="nearest")
     y = x - base
     h = max(1, int(round(0.1 * per)))
-    # extremes between zero crossings, with hysteresis against noise-born crossings
-    sgn = np.sign(y)
-    zc = np.flatnonzero(np.diff(sgn) != 0)
+    zc = np.flatnonzero(np.diff(np.sign(y)) != 0)
     if zc.size < 3:
         return np.empty(0), np.empty(0)
-    min_gap = 0.3 * per
     keep = [zc[0]]
     for z in zc[1:]:
-        if z - keep[-1] >= min_gap:
+        if z - keep[-1] >= 0.3 * per:
             keep.append(z)
     zc = np.asarray(keep)
     u = np.arange(-h, h + 1, dtype=float)
-    V = np.vstack([np.ones_like(u), u, u * u]).T
-    pinv = np.linalg.pinv(V)
+    pinv = np.linalg.pinv(np.vstack([np.ones_like(u), u, u * u]).T)
     tk, vk = [], []
     for a, b in zip(zc[:-1], zc[1:]):
         seg = y[a + 1:b + 1]
@@ -123,19 +136,27 @@ def cycle_peaks(x: np.ndarray, fs: float, fd: float) -> tuple[np.ndarray, np.nda
             continue
         tk.append((i + du) / fs)
         vk.append(c0 - c1 * c1 / (4 * c2))
-    tk, vk = np.asarray(tk), np.asarray(vk)
-    if tk.size < 2:
+    return np.asarray(tk), np.asarray(vk)
+
+
+def cycle_peaks(x: np.ndarray, fs: float, fd: float) -> tuple[np.ndarray, np.ndarray]:
+    """Half-cycle amplitudes of an oscillation at about ``fd`` Hz: (times in s, amplitudes).
+
+    Three consecutive extremes (peak, trough, peak or the reverse) half a period apart give
+    |(v[i-1] + v[i+1]) / 2 - v[i]| / 2 at the middle one: offset and linear drift cancel exactly,
+    and the constant factors from the parabola and the decay within the triple drop out of any
+    log-slope.
+    """
+    tk, vk = extremes(x, fs, fd)
+    if tk.size < 3:
         return np.empty(0), np.empty(0)
-    # pair each extreme with the next one of opposite sign (about half a cycle later)
-    amp = 0.5 * np.abs(vk[1:] - vk[:-1])
-    tm = 0.5 * (tk[1:] + tk[:-1])
-    ok = np.sign(vk[1:] - base_at(base, tk[1:], fs)) != np.sign(vk[:-1] - base_at(base, tk[:-1], fs))
-    return tm[ok], amp[ok]
-
-
-def base_at(base: np.ndarray, t: np.ndarray, fs: float) -> np.ndarray:
-    i = np.clip(np.round(t * fs).astype(int), 0, base.size - 1)
-    return base[i]
+    per = fs / fd
+    amp = 0.5 * np.abs(0.5 * (vk[:-2] + vk[2:]) - vk[1:-1])
+    half = np.diff(tk) * fs
+    even = np.abs(half[1:] - half[:-1]) < 0.1 * per  # evenly spaced: no missed extreme inside
+    alt = np.sign(vk[1:-1] - vk[:-2]) != np.sign(vk[2:] - vk[1:-1])
+    ok = even & alt
+    return tk[1:-1][ok], amp[ok]
 
 
 def spectral_peak(x: np.ndarray, fs: float, band=None) -> float:
@@ -146,10 +167,13 @@ def spectral_peak(x: np.ndarray, fs: float, band=None) -> float:
     """
     n = x.size
     nfft = int(2 ** np.ceil(np.log2(max(4 * n, 1024))))
-    X = np.abs(np.fft.rfft(x - x.mean(), nfft))
+    k = np.arange(n)
+    X = np.abs(np.fft.rfft(x - np.polyval(np.polyfit(k, x, 1), k), nfft))  # offset and drift out
     f = np.fft.rfftfreq(nfft, 1 / fs)
     sel = np.ones_like(f, bool) if band is None else (f >= band[0]) & (f <= band[1])
-    sel[0] = False
+    sel &= f >= 2 * fs / n  # at least two cycles in the record
+    if not sel.any():
+        sel = f > 0
     k = np.flatnonzero(sel)[np.argmax(X[sel])]
     if 0 < k < X.size - 1:
         a, b, c = np.log(X[k - 1:k + 2] + 1e-300)

@@ -11,7 +11,7 @@ from scipy import signal as _sig
 from ..core._validate import as_record, check_band, clean_signal, response_channel
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import ModalEstimate
-from ._decay import clipped_mask, cycle_peaks, decay_start, noise_std, spectral_peak
+from ._decay import baseline_line, clipped_mask, cycle_peaks, decay_start, noise_std, spectral_peak
 
 __all__ = ["log_decrement", "hilbert_decay", "half_power", "zeta_from_delta"]
 
@@ -108,11 +108,15 @@ def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: 
     rec, idx, x, band, flags, i0, skip = _prepare(rec, channel, band, start, fs)
     fsr = rec.fs
     fd0 = spectral_peak(x, fsr, band)
-    noise = noise_std(x, fsr)
+    x = x - baseline_line(x, fsr, fd0)  # offset and drift would shift the extremes in time
+    noise = max(noise_std(x, fsr), 1e-9 * float(np.max(np.abs(x))))
     tp, ap = cycle_peaks(x, fsr, fd0)
     keep = (tp >= skip / fsr) & (tp <= (x.size - skip) / fsr)
     tp, ap = tp[keep], ap[keep]
-    tp, ap = tp[::2], ap[::2]  # non-overlapping peak/trough pairs: independent amplitudes
+    # amplitudes two half-cycles apart (peaks, or troughs) share no extreme except at the ends
+    h = np.round((tp - tp[0]) * 2 * fd0).astype(int) if tp.size else np.empty(0, int)
+    par = h % 2 == 0
+    tp, ap = tp[par], ap[par]
     below = np.flatnonzero(ap <= PEAK_SNR * noise)
     if below.size:
         flags.append("noise_floor")

@@ -545,7 +545,7 @@ def _nonlinear_damping(x, fs, fd, noise, t_end):
     cut = False
     if tp.size > 2:
         dt = np.diff(tp) * 2 * fd  # in half periods; a missed extreme gives 3, a phase jump 1.5
-        bad = np.flatnonzero((np.abs(dt - np.round(dt)) > 0.1) | (np.round(dt) < 1))
+        bad = np.flatnonzero((np.abs(dt - np.round(dt)) > 0.25) | (np.round(dt) < 1))
         bad = bad[ok[bad + 1]]
         if bad.size:
             ok[bad[0] + 1:] = False
@@ -638,7 +638,7 @@ def _coulomb_check(x, fs, rec, idx, flags, i0, how):
     # point: frequency, friction decay, amplitude, release time and offset
     from scipy.optimize import least_squares
     from ..synth import coulomb_response
-    te0 = icpt - half / 2
+    te0 = icpt - half * np.floor(icpt / half)  # the earliest turning point in the record
     i_a = max(0, int(np.ceil(te0 * fs)))
     t = np.arange(x.size) / fs
     a0 = float(np.interp(te0, t, x) - np.median(x[-max(8, x.size // 10):]))
