@@ -1,0 +1,96 @@
+"""The command line, run in-process through main(argv) and once as the installed console script."""
+import io
+import json
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import vibmeasure as vm
+from vibmeasure.cli import main
+
+
+def run(argv):
+    out, err = io.StringIO(), io.StringIO()
+    code = main(argv, out=out, err=err)
+    return code, out.getvalue(), err.getvalue()
+
+
+def test_text_report_on_sample(sample_dir):
+    code, out, err = run(["ringdown", str(sample_dir / "ringdown_beam.csv")])
+    assert code == 0
+    assert "23.6" in out and "fn [Hz]" in out
+
+
+def test_json_document_keys_and_values(sample_dir):
+    code, out, _ = run(["ringdown", str(sample_dir / "ringdown_3modes.h5"), "--json"])
+    assert code == 0
+    doc = json.loads(out)
+    assert doc["method"] == "ml" and doc["unit"] == "m" and doc["fs_hz"] == 2000.0
+    modes = doc["modes"]
+    assert [set(m) >= {"fn_hz", "zeta", "fn_std_hz", "zeta_std", "method", "flags"} for m in modes] == [True] * 3
+    truth = ([21.3, 57.9, 110.4], [0.010, 0.020, 0.015])
+    for m, f, z in zip(modes, *truth):
+        # the sample is synthetic at 40 dB: within 5 reported std of the truth
+        assert abs(m["fn_hz"] - f) < 5 * m["fn_std_hz"]
+        assert abs(m["zeta"] - z) < 5 * m["zeta_std"]
+
+
+@pytest.mark.parametrize("method", ["logdec", "hilbert", "halfpower"])
+def test_classic_methods_from_cli(sample_dir, method):
+    code, out, _ = run(["ringdown", str(sample_dir / "ringdown_beam.csv"), "--method", method, "--json"])
+    assert code == 0
+    m = json.loads(out)["modes"][0]
+    assert m["method"] == method and m["fn_hz"] == pytest.approx(23.7, rel=2e-3)
+    assert m["zeta"] == pytest.approx(0.012, rel=0.05)
+
+
+def test_plot_written_atomically(sample_dir, tmp_path):
+    png = tmp_path / "fit.png"
+    code, _, err = run(["ringdown", str(sample_dir / "ringdown_beam.csv"), "--plot", str(png)])
+    assert code == 0 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["fit.png"]
+
+
+def test_errors_exit_2_and_write_nothing(tmp_path):
+    bad = tmp_path / "bare.csv"
+    bad.write_text("1\n2\n3\n" * 50)
+    png = tmp_path / "out.png"
+    code, out, err = run(["ringdown", str(bad), "--plot", str(png)])
+    assert code == 2 and out == ""
+    assert err.startswith("vibmeasure: error:") and "fs (sampling rate in Hz) is required" in err
+    assert not png.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["bare.csv"]
+    code, _, err = run(["ringdown", str(bad), "--fs", "100"])
+    assert code == 2 and "vibmeasure: error:" in err  # a staircase is no decay
+    code, _, err = run(["ringdown", str(tmp_path / "missing.h5")])
+    assert code == 2 and "does not exist" in err
+
+
+def test_wrong_channel_and_bad_modes(sample_dir):
+    code, _, err = run(["ringdown", str(sample_dir / "ringdown_beam.csv"), "--channel", "nope"])
+    assert code == 2 and "'nope' is not in this record" in err
+    code, _, err = run(["ringdown", str(sample_dir / "ringdown_beam.csv"), "--modes", "many"])
+    assert code == 2 and "--modes" in err
+    with pytest.raises(SystemExit) as ex:
+        run(["ringdown", str(sample_dir / "ringdown_beam.csv"), "--method", "magic"])
+    assert ex.value.code == 2
+
+
+def test_quality_warnings_go_to_stderr_and_json(sample_dir):
+    code, out, err = run(["ringdown", str(sample_dir / "coulomb_decay.csv"), "--json"])
+    assert code == 0
+    doc = json.loads(out)
+    assert doc["modes"][0]["zeta"] is None and "coulomb_friction" in doc["flags"]
+    assert doc["extras"]["friction_decay_per_cycle"] == pytest.approx(4e-4, rel=0.01)
+    assert "vibmeasure: warning:" in err and doc["warnings"]
+
+
+def test_console_script_installed(sample_dir):
+    exe = shutil.which("vibmeasure")
+    cmd = [exe] if exe else [sys.executable, "-m", "vibmeasure.cli"]
+    r = subprocess.run(cmd + ["ringdown", str(sample_dir / "ringdown_beam.csv"), "--json"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["modes"][0]["fn_hz"] == pytest.approx(23.7, rel=1e-3)
