@@ -94,3 +94,14 @@ def test_console_script_installed(sample_dir):
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout)["modes"][0]["fn_hz"] == pytest.approx(23.7, rel=1e-3)
+
+
+def test_force_channel_option_on_real_hammer_test(shared_data):
+    code, out, err = run(["ringdown", str(shared_data("impact/case1.mat")), "--force", "Time_chan_1", "--json"])
+    assert code == 0
+    doc = json.loads(out)
+    assert "start_detected" in doc["flags"] and doc["extras"]["channel"] == "Time_chan_2"
+    fns = [m["fn_hz"] for m in doc["modes"]]
+    assert min(abs(f - 34.06) for f in fns) < 0.01 and min(abs(f - 212.1) for f in fns) < 0.01
+    code, _, err = run(["ringdown", str(shared_data("impact/case1.mat")), "--force", "hammer"])
+    assert code == 2 and "'hammer' is not in this record" in err

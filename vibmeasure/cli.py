@@ -30,6 +30,8 @@ def _parser() -> argparse.ArgumentParser:
                        description="Identify fn and zeta (with standard deviations) from a ring-down record.")
     r.add_argument("file", help="record: .csv .h5 .wav .mat .lvm")
     r.add_argument("--channel", help="response channel name (default: the first that is not a force)")
+    r.add_argument("--force", metavar="NAME",
+                   help="channel holding the hammer/shaker force: the decay is fitted after its pulse")
     r.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
     r.add_argument("--unit", help="unit of the data when the file does not say (m, mm/s, g, m/s^2, ...)")
     r.add_argument("--quantity", choices=("displacement", "velocity", "acceleration", "force"),
@@ -48,6 +50,12 @@ def _ringdown(args, out):
     from . import io
     from .identify import damping, ringdown as rd
     rec = io.read(args.file, fs=args.fs, unit=args.unit, quantity=args.quantity)
+    if args.force:
+        import dataclasses
+        i = rec.index(args.force)
+        chans = list(rec.channels)
+        chans[i] = dataclasses.replace(chans[i], quantity="force", unit="")
+        rec = rec.replace(channels=tuple(chans), note=f"channel {args.force!r} marked as force")
     modes = args.modes
     if modes != "auto":
         try:

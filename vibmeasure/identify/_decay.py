@@ -75,7 +75,7 @@ def decay_start(rec: Record, idx: int, x: np.ndarray) -> tuple[int, str]:
         # impact response: the free decay begins at the peak, after the excitation
         y = np.abs(x - np.median(x))
         ip = int(np.argmax(y))
-        if 0 < ip < nb and y[0] < 0.2 * y[ip]:
+        if 0 < ip < max(nb, x.size // 50) and y[0] < 0.2 * y[ip]:
             return ip, "after impact peak"
         return 0, "start"
     j = int(np.argmax(rms > 0.5 * rms.max()))
