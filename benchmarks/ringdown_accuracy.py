@@ -50,7 +50,8 @@ def stats(err, std, bound):
     err = np.asarray(err)
     ok = np.isfinite(err)
     e = err[ok]
-    rep = np.nanmean(std) / e.std() if std is not None else np.nan
+    std = np.asarray(std, dtype=float)
+    rep = np.mean(std[np.isfinite(std)]) / e.std() if np.isfinite(std).any() else np.nan
     return np.sqrt(np.mean(e ** 2)) / bound, e.mean() / bound, rep, int((~ok).sum())
 
 
