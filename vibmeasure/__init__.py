@@ -9,17 +9,26 @@ from . import synth
 from .core import units
 from .core.errors import FitError, ParameterError, QualityWarning, UnitError, VibMeasureError
 from .core.record import Channel, Record
-from .core.results import ModalEstimate
+from .core.results import ModalEstimate, Peaks, Spectrogram, Spectrum
 from .identify.damping import half_power, hilbert_decay, log_decrement, zeta_from_delta
 from .identify.ringdown import ringdown, ringdown_crb
-from .io import read, write
+from .io import LazyRecord, read, write
+from .io import open_record as open  # noqa: A001  (vm.open: the documented name)
+from .signal.demod import envelope, envelope_spectrum
+from .signal.peaks import harmonic_family, pick_peaks, sideband_family
+from .signal.preprocess import decimate, detrend, differentiate, integrate, resample
+from .signal.preprocess import filter  # noqa: A004  (vm.filter: Butterworth, zero-phase)
+from .signal.spectral import amplitude_spectrum, band_rms, coherence, csd, octave_bands, psd, spectrogram
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "Channel", "Record", "ModalEstimate",
+    "Channel", "Record", "LazyRecord", "ModalEstimate", "Spectrum", "Spectrogram", "Peaks",
     "VibMeasureError", "ParameterError", "UnitError", "FitError", "QualityWarning",
-    "read", "write",
+    "read", "write", "open",
+    "amplitude_spectrum", "psd", "csd", "coherence", "spectrogram", "band_rms", "octave_bands",
+    "pick_peaks", "harmonic_family", "sideband_family", "envelope", "envelope_spectrum",
+    "detrend", "filter", "decimate", "resample", "integrate", "differentiate",
     "ringdown", "ringdown_crb", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
     "synth", "units", "__version__",
 ]

@@ -43,7 +43,119 @@ def _parser() -> argparse.ArgumentParser:
                         "hilbert: Hilbert envelope; halfpower: half-power bandwidth of the decay spectrum")
     r.add_argument("--json", action="store_true", help="print one JSON document")
     r.add_argument("--plot", metavar="OUT.png", help="write a picture of the record, fit and residual")
+
+    sp = sub.add_parser("spectrum", help="amplitude spectrum, PSD or envelope spectrum with peaks",
+                        description="Amplitude-correct spectrum, Welch PSD or squared-envelope spectrum of a "
+                                    "record; HDF5 records are streamed from disk.")
+    sp.add_argument("file", help="record: .csv .h5 .wav .mat .lvm")
+    sp.add_argument("--kind", choices=("amplitude", "psd", "envelope"), default="amplitude")
+    sp.add_argument("--channel", action="append", help="channel(s) to analyse (default: all; envelope: first)")
+    sp.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
+    sp.add_argument("--unit", help="unit of the data when the file does not say (m, mm/s, g, m/s^2, ...)")
+    sp.add_argument("--nperseg", type=int, help="segment length (default: psd 4096, amplitude whole record)")
+    sp.add_argument("--window", default="hann", help="window name (hann, flattop, boxcar, hamming, ...)")
+    sp.add_argument("--scaling", choices=("peak", "rms", "peak-to-peak"), default="peak",
+                    help="amplitude scaling (amplitude and envelope spectra)")
+    sp.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"),
+                    help="frequency band (Hz) for peaks and output; for --kind envelope the demodulation band")
+    sp.add_argument("--peaks", type=int, default=10, metavar="N", help="report the N strongest peaks (default 10)")
+    sp.add_argument("--csv", metavar="OUT.csv", help="write the spectrum as a table")
+    sp.add_argument("--json", action="store_true", help="print one JSON document")
+    sp.add_argument("--plot", metavar="OUT.png", help="write a picture of the spectrum and its peaks")
     return p
+
+
+class _Progress:
+    """A progress bar on stderr that appears only once work has taken more than a moment."""
+
+    def __init__(self, err, label, after_s=1.5):
+        import time
+        self.err, self.label, self.after, self.t0, self.shown, self._time = err, label, after_s, time.time(), False, time
+        self.last = -1
+
+    def __call__(self, fraction):
+        if self._time.time() - self.t0 < self.after and not self.shown:
+            return
+        pct = int(100 * fraction)
+        if pct == self.last:
+            return
+        self.last, self.shown = pct, True
+        bar = "#" * (pct // 4) + "." * (25 - pct // 4)
+        self.err.write(f"\r{self.label} [{bar}] {pct:3d}%")
+        self.err.flush()
+
+    def close(self):
+        if self.shown:
+            self.err.write("\n")
+            self.err.flush()
+
+
+def _spectrum(args, out, err):
+    from . import io
+    from .signal import demod, peaks as pk, spectral
+    p = Path(args.file)
+    if p.suffix.lower() in (".h5", ".hdf5") and args.fs is None:
+        try:
+            rec = io.open_record(p, unit=args.unit)
+        except VibMeasureError:
+            rec = io.read(p, fs=args.fs, unit=args.unit)
+    else:
+        rec = io.read(p, fs=args.fs, unit=args.unit)
+    chans = args.channel
+    bar = _Progress(err, args.kind)
+    try:
+        if args.kind == "psd":
+            spec = spectral.psd(rec, nperseg=args.nperseg, window=args.window, channels=chans, progress=bar)
+        elif args.kind == "amplitude":
+            spec = spectral.amplitude_spectrum(rec, nperseg=args.nperseg, window=args.window, scaling=args.scaling,
+                                               channels=chans, progress=bar)
+        else:
+            if not hasattr(rec, "data"):
+                rec = rec.load()
+            spec = demod.envelope_spectrum(rec, band=args.band, channel=chans[0] if chans else None,
+                                           window=args.window, nperseg=args.nperseg)
+    finally:
+        bar.close()
+    band = tuple(args.band) if args.band and args.kind != "envelope" else None
+    found = [pk.pick_peaks(spec, n=args.peaks, band=band, channel=i) for i in range(spec.n_channels)]
+    return rec, spec, found, band
+
+
+def _spectrum_outputs(args, spec, found, band):
+    import numpy as np
+    if args.csv:
+        from .io._common import atomic_path
+        df = spec.to_frame()
+        if band:
+            df = df[(df.freq_hz >= band[0]) & (df.freq_hz <= band[1])]
+        with atomic_path(args.csv) as tmp:
+            df.to_csv(tmp, index=False, float_format="%.10g")
+    if args.plot:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        from .plot import plot_spectrum
+        ax = plot_spectrum(spec, peaks=found[0] if found else None)
+        if band:
+            ax.set_xlim(*band)
+        _atomic_savefig(ax.figure, args.plot)
+        plt.close(ax.figure)
+
+
+def _atomic_savefig(fig, path):
+    import os
+    import tempfile
+    p = Path(path)
+    if not p.parent.exists():
+        raise VibMeasureError(f"{path!r}: folder {str(p.parent)!r} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=p.suffix or ".png", dir=p.parent)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=120, bbox_inches="tight")
+        os.replace(tmp, p)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
 
 
 def _ringdown(args, out):
@@ -77,25 +189,15 @@ def _ringdown(args, out):
 
 
 def _save_plot(path, rec, est):
-    import os
-    import tempfile
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from .plot import plot_ringdown
-    p = Path(path)
-    if not p.parent.exists():
-        raise VibMeasureError(f"--plot {path!r}: folder {str(p.parent)!r} does not exist")
     ax, _ = plot_ringdown(rec, est)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=p.suffix or ".png", dir=p.parent)
-    os.close(fd)
     try:
-        ax.figure.savefig(tmp, dpi=120, bbox_inches="tight")
-        os.replace(tmp, p)
+        _atomic_savefig(ax.figure, path)
     finally:
         plt.close(ax.figure)
-        if os.path.exists(tmp):
-            os.unlink(tmp)
 
 
 def _report_text(args, rec, est, caught, out):
@@ -120,6 +222,8 @@ def main(argv=None, *, out=None, err=None) -> int:
     out = out or sys.stdout
     err = err or sys.stderr
     args = _parser().parse_args(argv)
+    if args.command == "spectrum":
+        return _main_spectrum(args, out, err)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", QualityWarning)
         try:
@@ -139,6 +243,36 @@ def main(argv=None, *, out=None, err=None) -> int:
         print(f"vibmeasure: warning: {m}", file=err)
     if args.plot:
         print(f"vibmeasure: wrote {args.plot}", file=err)
+    return 0
+
+
+def _main_spectrum(args, out, err) -> int:
+    try:
+        rec, spec, found, band = _spectrum(args, out, err)
+        _spectrum_outputs(args, spec, found, band)
+    except (VibMeasureError, OSError) as exc:
+        print(f"vibmeasure: error: {exc}", file=err)
+        return 2
+    if args.json:
+        from .core.results import _jsonable
+        doc = {"command": "spectrum", "file": str(args.file), "kind": spec.kind, "unit": spec.unit,
+               "df_hz": spec.df, "n_lines": int(spec.freq.size), "channels": list(spec.channels),
+               "params": _jsonable(dict(spec.params)),
+               "peaks": {c: [{"freq_hz": float(f), "amplitude": float(a), "prominence": float(pr)}
+                             for f, a, pr in zip(p.freq, p.amplitude, p.prominence)]
+                         for c, p in zip(spec.channels, found)}}
+        json.dump(doc, out, indent=2, allow_nan=False)
+        out.write("\n")
+    else:
+        print(f"{args.file}  {spec.kind} [{spec.unit or '-'}]  df {spec.df:.5g} Hz  "
+              f"{spec.params.get('n_averages', 1)} averages  window {spec.params.get('window')}", file=out)
+        for c, p in zip(spec.channels, found):
+            print(f"channel {c}: {len(p)} peaks", file=out)
+            for f, a in zip(p.freq, p.amplitude):
+                print(f"  {f:14.6g} Hz  {a:12.5g}", file=out)
+    for what in ("csv", "plot"):
+        if getattr(args, what):
+            print(f"vibmeasure: wrote {getattr(args, what)}", file=err)
     return 0
 
 

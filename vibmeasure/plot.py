@@ -13,7 +13,7 @@ from .core.errors import ParameterError
 from .core.record import Record
 from .core.results import ModalEstimate
 
-__all__ = ["plot_ringdown", "decay_model"]
+__all__ = ["plot_ringdown", "plot_spectrum", "decay_model"]
 
 
 def decay_model(est: ModalEstimate, t: np.ndarray) -> np.ndarray:
@@ -76,3 +76,38 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
     axr.set_xlabel("time [s]")
     ax.legend(loc="upper right", fontsize=8)
     return ax, axr
+
+
+def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: bool | None = None):
+    """A spectrum (one or all channels) with optional picked peaks and labelled reference lines.
+
+    ``lines`` maps a label to a frequency in Hz (e.g. {"BPFO": 107.4}); ``log`` defaults to a
+    logarithmic amplitude axis for PSDs.
+    """
+    import matplotlib.pyplot as plt
+    from .core.results import Spectrum
+    if not isinstance(spec, Spectrum):
+        raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
+    if ax is None:
+        _, ax = plt.subplots(figsize=(9, 4.5))
+    rows = range(spec.n_channels) if channel is None else [spec.channels.index(channel)
+                                                           if isinstance(channel, str) else channel]
+    for i in rows:
+        ax.plot(spec.freq, np.abs(spec.values[i]), lw=0.7, label=spec.channels[i])
+    if peaks is not None and len(peaks):
+        ax.plot(peaks.freq, peaks.amplitude, "v", color="C3", ms=5, label="peaks")
+        for f, a in zip(peaks.freq[:10], peaks.amplitude[:10]):
+            ax.annotate(f"{f:.4g}", (f, a), textcoords="offset points", xytext=(3, 4), fontsize=7)
+    for label, f in (lines or {}).items():
+        ax.axvline(f, color="0.5", lw=0.6, ls="--")
+        ax.text(f, 1.0, f" {label}", transform=ax.get_xaxis_transform(), rotation=90, va="top", fontsize=7)
+    if log if log is not None else spec.kind in ("psd", "power"):
+        ax.set_yscale("log")
+    ax.set_xlabel("frequency [Hz]")
+    ylab = {"amplitude": f"amplitude ({spec.params.get('scaling', 'peak')})", "psd": "PSD", "power": "power",
+            "envelope": "squared-envelope spectrum"}.get(spec.kind, spec.kind)
+    ax.set_ylabel(f"{ylab} [{spec.unit or '-'}]")
+    ax.set_title(f"{spec.kind}: window {spec.params.get('window', '?')}, nperseg {spec.params.get('nperseg', '?')}, "
+                 f"df {spec.df:.4g} Hz, {spec.params.get('n_averages', 1)} averages", fontsize=9)
+    ax.legend(loc="upper right", fontsize=8)
+    return ax

@@ -10,7 +10,7 @@ import numpy as np
 
 from .errors import ParameterError
 
-__all__ = ["ModalEstimate", "FLAG_TEXT"]
+__all__ = ["ModalEstimate", "Spectrum", "Spectrogram", "Peaks", "FLAG_TEXT"]
 
 # Every quality flag a result may carry, with the sentence a report prints for it.
 FLAG_TEXT = {
@@ -154,3 +154,126 @@ def _jsonable(obj):
     if isinstance(obj, (np.bool_,)):
         return bool(obj)
     return obj
+
+
+@dataclass(frozen=True)
+class Spectrum:
+    """A frequency-domain result: ``values`` (n_channels, n_freq) at ``freq`` (Hz).
+
+    ``kind`` is "amplitude" (scaling peak, rms or peak-to-peak, in the channel unit), "psd"
+    (density, unit^2/Hz), "power" (unit^2 per line), "envelope" (amplitude of the squared
+    envelope's spectrum), "csd" (complex) or "coherence" (ratio). ``params`` holds what it was made
+    with (window, nperseg, noverlap, nfft, detrend, average, n_averages, enbw_hz, scaling).
+    """
+
+    freq: np.ndarray
+    values: np.ndarray
+    kind: str
+    unit: str = ""
+    channels: tuple[str, ...] = ()
+    quantity: str = "unknown"
+    params: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self):
+        f = np.asarray(self.freq, dtype=float)
+        v = np.asarray(self.values)
+        if v.ndim == 1:
+            v = v[np.newaxis]
+        if f.ndim != 1 or v.ndim != 2 or v.shape[1] != f.size:
+            raise ParameterError(f"values must have shape (n_channels, {f.size}) for {f.size} frequencies, "
+                                 f"got {v.shape}")
+        chans = tuple(self.channels) if self.channels else tuple(f"ch{i}" for i in range(v.shape[0]))
+        if len(chans) != v.shape[0]:
+            raise ParameterError(f"channels has {len(chans)} names for {v.shape[0]} rows of values")
+        f.setflags(write=False)
+        v = v.copy()
+        v.setflags(write=False)
+        object.__setattr__(self, "freq", f)
+        object.__setattr__(self, "values", v)
+        object.__setattr__(self, "channels", chans)
+        object.__setattr__(self, "params", MappingProxyType(dict(self.params)))
+
+    @property
+    def df(self) -> float:
+        """Line spacing in Hz."""
+        return float(self.freq[1] - self.freq[0]) if self.freq.size > 1 else float("nan")
+
+    @property
+    def n_channels(self) -> int:
+        return self.values.shape[0]
+
+    def channel(self, channel: str | int = 0) -> np.ndarray:
+        if isinstance(channel, str):
+            if channel not in self.channels:
+                raise ParameterError(f"channel={channel!r} is not in this spectrum; channels are {list(self.channels)}")
+            channel = self.channels.index(channel)
+        return self.values[channel]
+
+    def to_frame(self):
+        """A pandas table: a freq_hz column and one column per channel."""
+        import pandas as pd
+        df = pd.DataFrame(self.values.T, columns=list(self.channels))
+        df.insert(0, "freq_hz", self.freq)
+        return df
+
+    def __repr__(self) -> str:
+        return (f"Spectrum({self.kind}, {self.n_channels} ch x {self.freq.size} lines, df={self.df:.4g} Hz, "
+                f"unit={self.unit!r})")
+
+
+@dataclass(frozen=True)
+class Spectrogram:
+    """Power spectral density over time: ``values`` (n_channels, n_freq, n_times)."""
+
+    freq: np.ndarray
+    times: np.ndarray
+    values: np.ndarray
+    unit: str = ""
+    channels: tuple[str, ...] = ()
+    params: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self):
+        v = np.asarray(self.values)
+        if v.ndim != 3 or v.shape[1:] != (np.size(self.freq), np.size(self.times)):
+            raise ParameterError(f"values must be (n_channels, n_freq, n_times), got {v.shape}")
+        object.__setattr__(self, "params", MappingProxyType(dict(self.params)))
+
+
+@dataclass(frozen=True)
+class Peaks:
+    """Spectral peaks: interpolated frequency (Hz), scalloping-corrected amplitude, prominence.
+
+    ``families`` maps a family name ("harmonics of 29.93 Hz", "sidebands of 1200 Hz +- 29.9 Hz")
+    to a list of dicts (order, expected_hz, found_hz, amplitude) when families were searched.
+    """
+
+    freq: np.ndarray
+    amplitude: np.ndarray
+    prominence: np.ndarray
+    channel: str = ""
+    unit: str = ""
+    kind: str = ""
+    families: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self):
+        f = np.atleast_1d(np.asarray(self.freq, float))
+        for name in ("amplitude", "prominence"):
+            a = np.atleast_1d(np.asarray(getattr(self, name), float))
+            if a.shape != f.shape:
+                raise ParameterError(f"{name} must have one value per peak ({f.size}), got {a.shape}")
+            object.__setattr__(self, name, a)
+        object.__setattr__(self, "freq", f)
+        object.__setattr__(self, "families", MappingProxyType(dict(self.families)))
+
+    def __len__(self) -> int:
+        return self.freq.size
+
+    def to_frame(self):
+        """A pandas table with freq, amplitude, prominence and unit, strongest first."""
+        import pandas as pd
+        return pd.DataFrame({"freq_hz": self.freq, "amplitude": self.amplitude, "prominence": self.prominence,
+                             "unit": [self.unit] * self.freq.size})
+
+    def __repr__(self) -> str:
+        rows = ", ".join(f"{f:.6g} Hz: {a:.4g}" for f, a in zip(self.freq[:6], self.amplitude[:6]))
+        return f"Peaks({len(self)} in {self.channel!r}: {rows}{' ...' if len(self) > 6 else ''})"

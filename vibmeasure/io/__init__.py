@@ -9,11 +9,12 @@ from ..core.errors import ParameterError
 from ..core.record import Record
 from .csvfile import read_csv, write_csv
 from .hdf5 import read_hdf5, write_hdf5
+from .lazy import LazyRecord, open_record
 from .lvm import read_lvm
 from .mat import read_mat
 from .wav import read_wav, write_wav
 
-__all__ = ["read", "write", "FORMATS"]
+__all__ = ["read", "write", "open_record", "LazyRecord", "FORMATS"]
 
 _READERS = {".csv": read_csv, ".txt": read_csv, ".tsv": read_csv, ".h5": read_hdf5, ".hdf5": read_hdf5,
             ".wav": read_wav, ".mat": read_mat, ".lvm": read_lvm}

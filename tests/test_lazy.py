@@ -1,0 +1,47 @@
+"""Out-of-core records: vm.open over real HDF5 files, streamed spectra equal in-memory ones."""
+import h5py
+import numpy as np
+import pytest
+
+import vibmeasure as vm
+import vibmeasure.signal.spectral as spectral
+
+
+def test_open_own_schema_and_stream_psd(tmp_path, rng, monkeypatch):
+    rec = vm.Record(rng.normal(size=(2, 300_000)), fs=2048.0,
+                    channels=[vm.Channel("a", "acceleration", "g"), vm.Channel("b", "acceleration", "g")])
+    p = vm.write(tmp_path / "r.h5", rec)
+    lazy = vm.open(p)
+    assert (lazy.n_channels, lazy.n_samples, lazy.fs, lazy.names) == (2, 300_000, 2048.0, ["a", "b"])
+    monkeypatch.setattr(spectral, "READ_SAMPLES", 50_000)  # force many blocks (segments straddle reads)
+    seen = []
+    streamed = vm.psd(lazy, nperseg=4096, progress=seen.append)
+    np.testing.assert_allclose(streamed.values, vm.psd(rec, nperseg=4096).values, rtol=1e-12)
+    assert len(seen) > 5 and seen[-1] == 1.0
+    amp = vm.amplitude_spectrum(lazy, channels=["b"])
+    assert amp.params["nperseg"] == 65536 and amp.channels == ("b",)
+    assert lazy.load() == vm.read(p).replace(history=lazy.load().history)
+
+
+def test_open_bare_float32_dataset(tmp_path):
+    p = tmp_path / "daq.h5"
+    t = np.arange(200_000) / 10_000.0
+    with h5py.File(p, "w") as f:
+        f.create_dataset("acq/ch1", data=(0.5 * np.sin(2 * np.pi * 250 * t)).astype(np.float32), chunks=(65536,))
+    with pytest.raises(vm.ParameterError, match="fs .sampling rate in Hz. is required"):
+        vm.open(p, dataset="acq/ch1")
+    lazy = vm.open(p, dataset="acq/ch1", fs=10_000.0, unit="g")
+    s = vm.amplitude_spectrum(lazy, nperseg=10_000, window="flattop")
+    assert s.values[0].max() == pytest.approx(0.5, rel=1e-6) and s.unit == "g"
+
+
+def test_open_errors(tmp_path):
+    with pytest.raises(vm.ParameterError, match="does not exist"):
+        vm.open(tmp_path / "no.h5")
+    (tmp_path / "x.csv").write_text("1\n")
+    with pytest.raises(vm.ParameterError, match="reads HDF5"):
+        vm.open(tmp_path / "x.csv")
+    bad = tmp_path / "bad.h5"
+    bad.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 50)
+    with pytest.raises(vm.ParameterError, match="unreadable"):
+        vm.open(bad)

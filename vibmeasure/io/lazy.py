@@ -1,0 +1,148 @@
+"""Out-of-core records: a lazy view of an HDF5 dataset, read block by block.
+
+``vm.open(path)`` returns a :class:`LazyRecord` over vibmeasure's own record schema, or over any
+1-D or (n_channels, n_samples) dataset when ``dataset`` and ``fs`` are given. Spectral functions
+stream it in blocks, so memory stays bounded however long the recording is.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import ParameterError
+from ..core.record import Channel, Record
+from ._common import require_fs
+
+__all__ = ["LazyRecord", "open_record"]
+
+
+class LazyRecord:
+    """A record whose samples stay on disk until a block of them is asked for.
+
+    It has what a :class:`~vibmeasure.Record` has except ``data``: ``fs``, ``channels``, ``t0``,
+    ``n_channels``, ``n_samples``, ``duration``, ``names``; ``read(start, stop)`` returns the
+    samples of that range as float64 (n_channels, stop - start); ``load()`` reads it all.
+    """
+
+    def __init__(self, path, dataset: str, fs: float, channels: tuple[Channel, ...], t0: float = 0.0,
+                 meta: dict | None = None):
+        self.path = Path(path)
+        self.dataset = dataset
+        self.fs = float(fs)
+        self.channels = tuple(channels)
+        self.t0 = float(t0)
+        self.meta = dict(meta or {})
+        with self._file() as f:
+            d = f[dataset]
+            self._shape = d.shape
+            self.dtype = d.dtype
+        self._one_d = len(self._shape) == 1
+
+    def _file(self):
+        import h5py
+        try:
+            return h5py.File(self.path, "r")
+        except (OSError, ValueError) as exc:
+            raise ParameterError(f"HDF5 file {str(self.path)!r} is unreadable: {exc}") from None
+
+    @property
+    def n_channels(self) -> int:
+        return 1 if self._one_d else self._shape[0]
+
+    @property
+    def n_samples(self) -> int:
+        return self._shape[-1]
+
+    @property
+    def duration(self) -> float:
+        return self.n_samples / self.fs
+
+    @property
+    def names(self) -> list[str]:
+        return [c.name for c in self.channels]
+
+    def index(self, channel) -> int:
+        if isinstance(channel, (int, np.integer)) and not isinstance(channel, bool):
+            if not -self.n_channels <= channel < self.n_channels:
+                raise ParameterError(f"channel={channel} is out of range for {self.n_channels} channels")
+            return int(channel) % self.n_channels
+        if channel not in self.names:
+            raise ParameterError(f"channel={channel!r} is not in this record; channels are {self.names}")
+        return self.names.index(channel)
+
+    def read(self, start: int, stop: int) -> np.ndarray:
+        """Samples start..stop of every channel as float64, shape (n_channels, stop - start)."""
+        start, stop = max(0, int(start)), min(self.n_samples, int(stop))
+        with self._file() as f:
+            d = f[self.dataset]
+            try:
+                a = d[start:stop] if self._one_d else d[:, start:stop]
+            except (OSError, ValueError) as exc:
+                raise ParameterError(f"{str(self.path)!r}: samples {start}..{stop} are unreadable "
+                                     f"(truncated file?): {exc}") from None
+        a = np.asarray(a, dtype=np.float64)
+        return a[np.newaxis] if self._one_d else a
+
+    def load(self) -> Record:
+        """Read everything into an in-memory :class:`Record`."""
+        return Record(self.read(0, self.n_samples), self.fs, self.channels, t0=self.t0, meta=self.meta,
+                      history=(f"read {self.path} [{self.dataset}]",))
+
+    def __repr__(self) -> str:
+        return (f"LazyRecord({self.n_channels} ch x {self.n_samples} samples, fs={self.fs:g} Hz, "
+                f"{self.dtype}, {str(self.path)!r}:{self.dataset})")
+
+
+def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: float | None = None,
+                quantity: str | None = None, unit: str | None = None) -> LazyRecord:
+    """Open an HDF5 record lazily (out-of-core).
+
+    A file in vibmeasure's schema needs nothing more; any other HDF5 file needs ``dataset`` (a
+    1-D or (n_channels, n_samples) dataset) and ``fs`` unless the dataset has an ``fs`` attribute.
+    """
+    import json
+    from .hdf5 import SCHEMA, _str_list
+    p = Path(path)
+    if not p.exists():
+        raise ParameterError(f"path={str(path)!r} does not exist")
+    if p.suffix.lower() not in (".h5", ".hdf5"):
+        raise ParameterError(f"path={str(path)!r}: vm.open reads HDF5 (.h5, .hdf5); use vm.read for {p.suffix!r}")
+    import h5py
+    try:
+        f = h5py.File(p, "r")
+    except (OSError, ValueError) as exc:
+        raise ParameterError(f"HDF5 file {str(path)!r} is unreadable (truncated or not HDF5): {exc}") from None
+    with f:
+        schema = f.attrs.get("vibmeasure_schema")
+        schema = schema.decode() if isinstance(schema, bytes) else schema
+        if dataset is None and schema == SCHEMA:
+            d = f["data"]
+            a = d.attrs
+            chans = tuple(Channel(n, q, u, loc) for n, q, u, loc in zip(
+                _str_list(a["channel_names"]), _str_list(a["channel_quantities"]),
+                _str_list(a["channel_units"]), _str_list(a["channel_locations"])))
+            rfs, t0 = float(a["fs"]), float(a["t0"])
+            if fs is not None and float(fs) != rfs:
+                raise ParameterError(f"fs={fs} contradicts {str(path)!r}, which stores fs={rfs}")
+            meta = json.loads(f.attrs.get("meta", "{}"))
+            return LazyRecord(p, "data", rfs, chans, t0=t0, meta=meta)
+        if dataset is None:
+            raise ParameterError(f"{str(path)!r} is not a vibmeasure record file: name the dataset (dataset=...)")
+        if dataset not in f:
+            raise ParameterError(f"dataset={dataset!r} is not in {str(path)!r}")
+        d = f[dataset]
+        if d.ndim not in (1, 2) or d.dtype.kind not in "fiu":
+            raise ParameterError(f"dataset={dataset!r} must be 1-D or (n_channels, n_samples) numbers, "
+                                 f"got shape {d.shape} dtype {d.dtype}")
+        attr_fs = next((float(d.attrs[k]) for k in ("fs", "sampling_rate", "fs_hz") if k in d.attrs), None)
+        fs = attr_fs if fs is None and attr_fs is not None else require_fs(fs, source=f"{str(path)!r}:{dataset}")
+        n_ch = 1 if d.ndim == 1 else d.shape[0]
+    from ..core import units as _units
+    q = quantity or (_units.quantity_of(unit) if unit else "unknown")
+    base = dataset.strip("/").replace("/", ".")
+    names = [base] if n_ch == 1 else [f"{base}[{i}]" for i in range(n_ch)]
+    chans = tuple(Channel(n, q, unit or "") for n in names)
+    return LazyRecord(p, dataset, fs, chans, meta={"source": str(p), "dataset": dataset})

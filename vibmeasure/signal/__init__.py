@@ -1,0 +1,1 @@
+"""Spectra, peaks, preprocessing and demodulation."""

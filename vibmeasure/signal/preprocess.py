@@ -1,0 +1,162 @@
+"""Preprocessing that returns new records with units, quantities and history updated.
+
+detrend, zero-phase Butterworth filters (second-order sections), decimate and resample, and
+integration/differentiation between displacement, velocity and acceleration, in the frequency
+domain (with a high-pass corner) or in the time domain (high-pass, trapezoid, drift removal).
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+from scipy import signal as _sig
+
+from ..core import units as _units
+from ..core._validate import as_record, check_band, positive
+from ..core.errors import ParameterError
+from ..core.record import Channel, Record
+
+__all__ = ["detrend", "filter", "decimate", "resample", "integrate", "differentiate", "DEFAULT_HIGHPASS_HZ"]
+
+DEFAULT_HIGHPASS_HZ = 2.0  # integration corner: below it a 1/f^k gain would turn noise and drift into blow-up
+
+
+def _finite(rec: Record, what: str):
+    if not np.isfinite(rec.data).all():
+        ch, i = np.argwhere(~np.isfinite(rec.data))[0]
+        raise ParameterError(f"{what}: channel {rec.channels[ch].name!r} has NaN/inf at sample {i}; "
+                             "the rule is finite data")
+
+
+def detrend(rec, *, type: str = "linear", fs: float | None = None) -> Record:
+    """Remove the mean ("constant") or the least-squares line ("linear") of every channel."""
+    rec = as_record(rec, fs=fs)
+    if type not in ("constant", "linear"):
+        raise ParameterError(f"type={type!r} must be 'constant' or 'linear'")
+    _finite(rec, "detrend")
+    return rec.replace(data=_sig.detrend(rec.data, axis=-1, type=type), note=f"detrend({type!r})")
+
+
+def filter(rec, *, kind: str, cutoff, order: int = 4, zero_phase: bool = True, fs: float | None = None) -> Record:
+    """Butterworth filter in second-order sections: kind "lowpass", "highpass" (cutoff in Hz) or
+    "bandpass", "bandstop" (cutoff = (lo, hi) Hz); zero-phase (forward-backward) by default."""
+    rec = as_record(rec, fs=fs)
+    if kind not in ("lowpass", "highpass", "bandpass", "bandstop"):
+        raise ParameterError(f"kind={kind!r} must be 'lowpass', 'highpass', 'bandpass' or 'bandstop'")
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or not 1 <= order <= 12:
+        raise ParameterError(f"order={order!r} must be an integer from 1 to 12")
+    nyq = rec.fs / 2
+    if kind in ("bandpass", "bandstop"):
+        lo, hi = check_band(cutoff, rec.fs, name="cutoff")
+        if lo <= 0 or hi >= nyq:
+            raise ParameterError(f"cutoff={cutoff!r} must lie strictly inside 0..fs/2 = {nyq:g} Hz")
+        wn = (lo, hi)
+    else:
+        wn = positive(cutoff, "cutoff")
+        if wn >= nyq:
+            raise ParameterError(f"cutoff={cutoff!r} must be below fs/2 = {nyq:g} Hz")
+    _finite(rec, "filter")
+    sos = _sig.butter(order, wn, btype=kind, fs=rec.fs, output="sos")
+    y = _sig.sosfiltfilt(sos, rec.data, axis=-1) if zero_phase else _sig.sosfilt(sos, rec.data, axis=-1)
+    return rec.replace(data=y, note=f"filter({kind}, {cutoff}, order={order}, zero_phase={zero_phase})")
+
+
+def decimate(rec, factor: int, *, fs: float | None = None) -> Record:
+    """Low-pass (zero-phase, order-8 Chebyshev I at 0.8 of the new Nyquist) and keep every factor-th sample."""
+    rec = as_record(rec, fs=fs)
+    if isinstance(factor, bool) or not isinstance(factor, (int, np.integer)) or factor < 1:
+        raise ParameterError(f"factor={factor!r} must be an integer >= 1")
+    if factor == 1:
+        return rec
+    if rec.n_samples < 27 * factor:
+        raise ParameterError(f"factor={factor} needs at least {27 * factor} samples; the record has {rec.n_samples}")
+    _finite(rec, "decimate")
+    y = _sig.decimate(rec.data, int(factor), ftype="iir", zero_phase=True, axis=-1)
+    return rec.replace(data=y, fs=rec.fs / factor, note=f"decimate({factor})")
+
+
+def resample(rec, fs_new: float, *, fs: float | None = None) -> Record:
+    """Polyphase resampling to ``fs_new`` Hz (rational ratio, Kaiser-windowed anti-alias filter)."""
+    rec = as_record(rec, fs=fs)
+    fs_new = positive(fs_new, "fs_new")
+    ratio = Fraction(fs_new / rec.fs).limit_denominator(1000)
+    if abs(float(ratio) * rec.fs - fs_new) > 1e-9 * fs_new:
+        raise ParameterError(f"fs_new={fs_new:g} / fs={rec.fs:g} is not a ratio of integers up to 1000")
+    _finite(rec, "resample")
+    y = _sig.resample_poly(rec.data, ratio.numerator, ratio.denominator, axis=-1)
+    return rec.replace(data=y, fs=rec.fs * float(ratio), note=f"resample({fs_new:g})")
+
+
+def _si(rec: Record, i: int) -> tuple[np.ndarray, Channel]:
+    c = rec.channels[i]
+    if c.quantity not in ("displacement", "velocity", "acceleration"):
+        raise ParameterError(f"channel {c.name!r} has quantity {c.quantity!r}; integration and differentiation "
+                             "need displacement, velocity or acceleration (give quantity= when reading)")
+    x = rec.data[i]
+    if c.unit:
+        x = _units.convert(x, c.unit, _units.SI_UNIT[c.quantity])
+    return x, c
+
+
+def integrate(rec, *, method: str = "frequency", highpass: float = DEFAULT_HIGHPASS_HZ, channels=None,
+              fs: float | None = None) -> Record:
+    """Acceleration -> velocity, velocity -> displacement, in SI units (g becomes m/s^2 first).
+
+    ``method="frequency"``: X(f) / (i 2 pi f) with every line below ``highpass`` Hz set to zero (a
+    sine of amplitude A at f becomes A / (2 pi f), exactly for whole periods). ``method="time"``:
+    mean removed, zero-phase 4th-order Butterworth high-pass at ``highpass``, trapezoidal
+    integration, then the drift removed (linear detrend and the same high-pass). The corner (default 2 Hz) keeps low-frequency noise and sensor offset from
+    blowing up; set it below the lowest frequency of interest. Displacement cannot be integrated.
+    """
+    return _calculus(rec, +1, method, highpass, channels, fs)
+
+
+def differentiate(rec, *, method: str = "frequency", channels=None, fs: float | None = None) -> Record:
+    """Displacement -> velocity, velocity -> acceleration, in SI units (frequency domain: X(f) i 2 pi f,
+    or central differences with ``method="time"``)."""
+    return _calculus(rec, -1, method, 0.0, channels, fs)
+
+
+def _calculus(rec, direction, method, highpass, channels, fs):
+    rec = as_record(rec, fs=fs)
+    if method not in ("frequency", "time"):
+        raise ParameterError(f"method={method!r} must be 'frequency' or 'time'")
+    hp = positive(highpass, "highpass", allow_zero=True)
+    if direction > 0 and hp >= rec.fs / 2:
+        raise ParameterError(f"highpass={highpass} must be below fs/2 = {rec.fs / 2:g} Hz")
+    idx = range(rec.n_channels) if channels is None else [rec.index(c) for c in (
+        [channels] if isinstance(channels, (str, int)) else channels)]
+    _finite(rec, "integrate" if direction > 0 else "differentiate")
+    data = np.array(rec.data)
+    chans = list(rec.channels)
+    n = rec.n_samples
+    f = np.fft.rfftfreq(n, 1 / rec.fs)
+    for i in idx:
+        x, c = _si(rec, i)
+        q_new = _units.integral_quantity(c.quantity) if direction > 0 else _units.derivative_quantity(c.quantity)
+        if method == "frequency":
+            X = np.fft.rfft(x)
+            jw = 2j * np.pi * f
+            if direction > 0:
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    Y = np.where(f >= max(hp, f[1] if f.size > 1 else 0.0), X / jw, 0.0)
+            else:
+                Y = X * jw
+            y = np.fft.irfft(Y, n)
+        elif direction > 0:
+            from scipy.integrate import cumulative_trapezoid
+            xx = x - x.mean()  # the offset first: integrated, it is the ramp that dominates the blow-up
+            sos = _sig.butter(4, hp, btype="highpass", fs=rec.fs, output="sos") if hp > 0 else None
+            if sos is not None:
+                xx = _sig.sosfiltfilt(sos, xx)
+            y = _sig.detrend(cumulative_trapezoid(xx, dx=1 / rec.fs, initial=0.0), type="linear")
+            if sos is not None:  # what the integration made of the residual low-frequency content
+                y = _sig.sosfiltfilt(sos, y)
+        else:
+            y = np.gradient(x, 1 / rec.fs)
+        data[i] = y
+        chans[i] = Channel(c.name, q_new, _units.SI_UNIT[q_new], c.location)
+    verb = "integrate" if direction > 0 else "differentiate"
+    note = f"{verb}(method={method!r}" + (f", highpass={hp:g} Hz)" if direction > 0 else ")")
+    return rec.replace(data=data, channels=tuple(chans), note=note)

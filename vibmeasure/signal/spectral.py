@@ -1,0 +1,398 @@
+"""Amplitude-correct spectra, PSD, CSD, coherence, spectrogram, band and octave RMS.
+
+All segment-averaged estimates reduce to one blocked engine (:func:`_segment_sums`): segments are
+taken as strided views, detrended, windowed and transformed 64 at a time (cache-sized batches),
+and their power or cross products are summed. The same engine streams a
+:class:`~vibmeasure.io.LazyRecord` from disk in bounded blocks, so a recording larger than memory
+is handled like one in memory. Results equal ``scipy.signal.welch``/``csd`` to round-off.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+import scipy.fft as _fft
+from scipy import signal as _sig
+
+from ..core.errors import ParameterError
+from ..core.record import Record
+from ..core.results import Spectrogram, Spectrum
+
+__all__ = ["amplitude_spectrum", "psd", "csd", "coherence", "spectrogram", "band_rms", "octave_bands",
+           "power_unit", "get_window"]
+
+BATCH = 64              # segments transformed together: fits the cache, amortises call overhead
+READ_SAMPLES = 1 << 21  # samples per channel read from a lazy source at a time
+MEDIAN_LIMIT = 20_000_000  # per-segment values kept for median averaging
+
+
+# ------------------------------------------------------------------------------------------------
+# sources and checks
+class _ArraySource:
+    """An in-memory record seen through the lazy-source interface (reads are views)."""
+
+    def __init__(self, rec: Record):
+        self.rec = rec
+        self.fs, self.channels, self.n_samples, self.n_channels = rec.fs, rec.channels, rec.n_samples, rec.n_channels
+
+    def read(self, start, stop):
+        return self.rec.data[:, start:stop]
+
+
+def _source(rec, fs=None):
+    from ..core._validate import as_record
+    from ..io.lazy import LazyRecord
+    if isinstance(rec, LazyRecord):
+        return rec
+    return _ArraySource(as_record(rec, fs=fs))
+
+
+def _channel_indices(src, channels) -> list[int]:
+    names = [c.name for c in src.channels]
+    if channels is None:
+        return list(range(src.n_channels))
+    if isinstance(channels, (str, int, np.integer)):
+        channels = [channels]
+    out = []
+    for c in channels:
+        if isinstance(c, (int, np.integer)) and not isinstance(c, bool):
+            if not 0 <= c < len(names):
+                raise ParameterError(f"channels={channels!r}: index {c} out of range for {len(names)} channels")
+            out.append(int(c))
+        elif c in names:
+            out.append(names.index(c))
+        else:
+            raise ParameterError(f"channels={channels!r}: {c!r} is not in this record; channels are {names}")
+    return out
+
+
+def get_window(window, n: int) -> np.ndarray:
+    """A periodic (DFT-even) window of length n by name, ("kaiser", beta) tuple or array."""
+    if isinstance(window, np.ndarray):
+        if window.shape != (n,):
+            raise ParameterError(f"window array has shape {window.shape}; it must have nperseg={n} values")
+        return window.astype(float)
+    try:
+        return _sig.get_window(window, n, fftbins=True)
+    except (ValueError, TypeError) as exc:
+        raise ParameterError(f"window={window!r} is not a known window ({exc}); e.g. 'hann', 'hamming', "
+                             "'flattop', 'boxcar', ('kaiser', 8.0)") from None
+
+
+def _check_params(n, nperseg, noverlap, nfft, detrend, average, default_nperseg):
+    if n < 2:
+        raise ParameterError(f"the record has {n} sample(s); a spectrum needs at least 2")
+    if nperseg is None:
+        nperseg = min(n, default_nperseg)
+    if isinstance(nperseg, bool) or not isinstance(nperseg, (int, np.integer)) or nperseg < 2:
+        raise ParameterError(f"nperseg={nperseg!r} must be an integer >= 2")
+    nperseg = int(nperseg)
+    if nperseg > n:
+        raise ParameterError(f"nperseg={nperseg} exceeds the record length {n} samples")
+    if noverlap is None:
+        noverlap = nperseg // 2
+    if isinstance(noverlap, bool) or not isinstance(noverlap, (int, np.integer)) or not 0 <= noverlap < nperseg:
+        raise ParameterError(f"noverlap={noverlap!r} must be an integer with 0 <= noverlap < nperseg={nperseg}")
+    nfft = nperseg if nfft is None else nfft
+    if isinstance(nfft, bool) or not isinstance(nfft, (int, np.integer)) or nfft < nperseg:
+        raise ParameterError(f"nfft={nfft!r} must be an integer >= nperseg={nperseg}")
+    if detrend not in ("constant", "linear", False, None):
+        raise ParameterError(f"detrend={detrend!r} must be 'constant', 'linear' or False")
+    if average not in ("mean", "median", "max"):
+        raise ParameterError(f"average={average!r} must be 'mean', 'median' or 'max' (peak hold)")
+    return nperseg, int(noverlap), int(nfft)
+
+
+def _check_band(band, fs, name="band"):
+    from ..core._validate import check_band
+    return check_band(band, fs, name=name)
+
+
+def power_unit(unit: str, *, density: bool) -> str:
+    """Unit of a squared quantity per Hz (density) or per line: 'g' -> 'g^2/Hz', 'm/s^2' -> '(m/s^2)^2/Hz'."""
+    if not unit:
+        return "1/Hz" if density else ""
+    u = f"({unit})^2" if any(c in unit for c in "/^*") else f"{unit}^2"
+    return u + "/Hz" if density else u
+
+
+# ------------------------------------------------------------------------------------------------
+# the engine
+def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), keep_segments=False,
+                  reducer="sum", progress: Callable[[float], None] | None = None):
+    """Sum (or max) over segments of |X|^2 per channel and of X_i conj(X_j) per pair.
+
+    Returns (autos (n_idx, nf), crosses (n_pairs, nf) complex, n_segments, per_segment or None).
+    """
+    n = src.n_samples
+    step = nperseg - noverlap
+    nseg = (n - nperseg) // step + 1
+    nf = nfft // 2 + 1
+    n_ch = len(idx)
+    autos = np.zeros((n_ch, nf)) if reducer == "sum" else np.full((n_ch, nf), -np.inf)
+    crosses = np.zeros((len(pairs), nf), complex)
+    per_seg = np.empty((n_ch, nseg, nf)) if keep_segments else None
+    if detrend == "linear":
+        tt = np.arange(nperseg) - (nperseg - 1) / 2
+        tt = tt / np.sqrt(tt @ tt)
+    sb = max(1, (READ_SAMPLES - nperseg) // step + 1)  # segments per read
+    names = [c.name for c in src.channels]
+    done = 0
+    for s0 in range(0, nseg, sb):
+        s1 = min(nseg, s0 + sb)
+        a0 = s0 * step
+        block = src.read(a0, (s1 - 1) * step + nperseg)
+        block = np.ascontiguousarray(block[idx], dtype=np.float64) if len(idx) != block.shape[0] or \
+            block.dtype != np.float64 or not block.flags.c_contiguous else block
+        if not np.isfinite(block).all():
+            bad = np.argwhere(~np.isfinite(block))[0]
+            raise ParameterError(f"channel {names[idx[bad[0]]]!r} has NaN/inf at sample {a0 + bad[1]}; the rule is "
+                                 "finite data: repair or cut the record first")
+        segs = np.lib.stride_tricks.as_strided(
+            block, shape=(n_ch, s1 - s0, nperseg),
+            strides=(block.strides[0], block.strides[1] * step, block.strides[1]), writeable=False)
+        for b0 in range(0, s1 - s0, BATCH):
+            y = segs[:, b0:b0 + BATCH]
+            if detrend == "constant":
+                y = y - y.mean(axis=-1, keepdims=True)
+            elif detrend == "linear":
+                y = y - y.mean(axis=-1, keepdims=True)
+                y = y - (y @ tt)[..., None] * tt
+            X = _fft.rfft(y * win, n=nfft, axis=-1)
+            P = X.real ** 2 + X.imag ** 2
+            if keep_segments:
+                per_seg[:, s0 + b0:s0 + b0 + P.shape[1]] = P
+            if reducer == "sum":
+                autos += P.sum(axis=1)
+            else:
+                np.maximum(autos, P.max(axis=1), out=autos)
+            for k, (i, j) in enumerate(pairs):
+                crosses[k] += (X[i] * X[j].conj()).sum(axis=0)
+        done = s1
+        if progress is not None:
+            progress(done / nseg)
+    return autos, crosses, nseg, per_seg
+
+
+def _one_sided(a, nfft):
+    a = a.copy()
+    hi = None if nfft % 2 else -1  # the Nyquist line of an even nfft is not doubled
+    a[..., 1:hi] *= 2
+    return a
+
+
+def _median_bias(n):
+    # median of chi^2_2 over its mean, as scipy applies it (ln 2 in the limit)
+    ii_2 = 2 * np.arange(1.0, (n - 1) // 2 + 1)
+    return 1 + np.sum(1.0 / (ii_2 + 1) - 1.0 / ii_2)
+
+
+def _averaged_power(src, idx, *, nperseg, noverlap, nfft, win, detrend, average, progress):
+    keep = average == "median"
+    if keep:
+        step = nperseg - noverlap
+        nseg = (src.n_samples - nperseg) // step + 1
+        if len(idx) * nseg * (nfft // 2 + 1) > MEDIAN_LIMIT:
+            raise ParameterError(f"average='median' keeps every segment ({nseg} x {nfft // 2 + 1} lines per channel): "
+                                 "too many here; use average='mean' or a shorter record")
+    autos, _, nseg, per = _segment_sums(src, idx, nperseg=nperseg, noverlap=noverlap, nfft=nfft, win=win,
+                                        detrend=detrend, keep_segments=keep,
+                                        reducer="max" if average == "max" else "sum", progress=progress)
+    if average == "mean":
+        return autos / nseg, nseg
+    if average == "max":
+        return autos, nseg
+    return np.median(per, axis=1) / _median_bias(nseg), nseg
+
+
+def _meta(src, idx):
+    ch = [src.channels[i] for i in idx]
+    units = {c.unit for c in ch}
+    quants = {c.quantity for c in ch}
+    return ch, (units.pop() if len(units) == 1 else ""), (quants.pop() if len(quants) == 1 else "unknown")
+
+
+# ------------------------------------------------------------------------------------------------
+def psd(rec, *, nperseg: int | None = None, noverlap: int | None = None, window="hann", detrend="constant",
+        average: str = "mean", scaling: str = "density", nfft: int | None = None, channels=None,
+        fs: float | None = None, progress: Callable[[float], None] | None = None) -> Spectrum:
+    """Welch power spectral density (or power spectrum) of every channel.
+
+    ``scaling="density"`` gives unit^2/Hz (energy-corrected with sum(w^2): Parseval holds, the
+    integral over frequency is the variance); ``"spectrum"`` gives unit^2 per line (amplitude-
+    corrected with sum(w)^2: a sine of amplitude A reads A^2/2). ``average`` "mean", "median"
+    (bias-corrected like scipy) or "max" (peak hold). Defaults: nperseg min(n, 4096), 50 % overlap,
+    Hann, constant detrend. ``rec`` may be a Record, a LazyRecord (streamed from disk) or an array
+    with ``fs``; ``progress(fraction)`` is called as blocks finish.
+    """
+    src = _source(rec, fs)
+    nperseg, noverlap, nfft = _check_params(src.n_samples, nperseg, noverlap, nfft, detrend, average, 4096)
+    if scaling not in ("density", "spectrum"):
+        raise ParameterError(f"scaling={scaling!r} must be 'density' or 'spectrum'")
+    idx = _channel_indices(src, channels)
+    win = get_window(window, nperseg)
+    P, nseg = _averaged_power(src, idx, nperseg=nperseg, noverlap=noverlap, nfft=nfft, win=win, detrend=detrend,
+                              average=average, progress=progress)
+    scale = 1.0 / (src.fs * (win @ win)) if scaling == "density" else 1.0 / win.sum() ** 2
+    P = _one_sided(P * scale, nfft)
+    ch, unit, q = _meta(src, idx)
+    enbw = src.fs * (win @ win) / win.sum() ** 2
+    return Spectrum(np.fft.rfftfreq(nfft, 1 / src.fs), P, "psd" if scaling == "density" else "power",
+                    power_unit(unit, density=scaling == "density"), tuple(c.name for c in ch), q,
+                    {"window": window if isinstance(window, (str, tuple)) else "array", "nperseg": nperseg,
+                     "noverlap": noverlap, "nfft": nfft, "detrend": detrend, "average": average, "fs": src.fs,
+                     "n_averages": nseg, "enbw_hz": enbw, "scaling": scaling})
+
+
+def amplitude_spectrum(rec, *, window="hann", nfft: int | None = None, scaling: str = "peak",
+                       nperseg: int | None = None, noverlap: int | None = None, average: str = "mean",
+                       detrend="constant", channels=None, fs: float | None = None,
+                       progress: Callable[[float], None] | None = None) -> Spectrum:
+    """Single-sided, amplitude-correct spectrum: a sine of amplitude A reads A at its frequency.
+
+    The window correction is computed from the actual window (2 / sum(w)), not from a table.
+    ``scaling`` "peak", "rms" (peak / sqrt 2) or "peak-to-peak". With ``nperseg`` the segments are
+    averaged in power ("mean", "median") or held ("max"); without it the whole record is one
+    segment (a lazy record defaults to 65536-sample segments). ``nfft`` zero-pads.
+    """
+    from ..io.lazy import LazyRecord
+    src = _source(rec, fs)
+    if scaling not in ("peak", "rms", "peak-to-peak"):
+        raise ParameterError(f"scaling={scaling!r} must be 'peak', 'rms' or 'peak-to-peak'")
+    default = 65536 if isinstance(src, LazyRecord) else src.n_samples
+    nperseg, noverlap, nfft = _check_params(src.n_samples, nperseg, noverlap, nfft, detrend, average, default)
+    idx = _channel_indices(src, channels)
+    win = get_window(window, nperseg)
+    P, nseg = _averaged_power(src, idx, nperseg=nperseg, noverlap=noverlap, nfft=nfft, win=win, detrend=detrend,
+                              average=average, progress=progress)
+    A = np.sqrt(P) / win.sum()
+    A[:, 1:None if nfft % 2 else -1] *= 2
+    A *= {"peak": 1.0, "rms": 1 / np.sqrt(2), "peak-to-peak": 2.0}[scaling]
+    if scaling == "rms":
+        A[:, 0] *= np.sqrt(2)  # a constant's rms is itself
+    ch, unit, q = _meta(src, idx)
+    return Spectrum(np.fft.rfftfreq(nfft, 1 / src.fs), A, "amplitude", unit, tuple(c.name for c in ch), q,
+                    {"window": window if isinstance(window, (str, tuple)) else "array", "nperseg": nperseg,
+                     "noverlap": noverlap, "nfft": nfft, "detrend": detrend, "average": average, "fs": src.fs,
+                     "n_averages": nseg, "scaling": scaling,
+                     "enbw_hz": src.fs * (win @ win) / win.sum() ** 2})
+
+
+def _pair_spectra(rec, x, y, nperseg, noverlap, window, detrend, nfft, fs, progress):
+    src = _source(rec, fs)
+    nperseg, noverlap, nfft = _check_params(src.n_samples, nperseg, noverlap, nfft, detrend, "mean", 4096)
+    ix, iy = _channel_indices(src, [x, y])
+    win = get_window(window, nperseg)
+    autos, cross, nseg, _ = _segment_sums(src, [ix, iy], nperseg=nperseg, noverlap=noverlap, nfft=nfft, win=win,
+                                          detrend=detrend, pairs=[(0, 1)], progress=progress)
+    scale = 1.0 / (src.fs * (win @ win))
+    return src, ix, iy, _one_sided(autos / nseg * scale, nfft), _one_sided(cross / nseg * scale, nfft), nseg, \
+        dict(nperseg=nperseg, noverlap=noverlap, nfft=nfft)
+
+
+def csd(rec, x, y, *, nperseg: int | None = None, noverlap: int | None = None, window="hann",
+        detrend="constant", nfft: int | None = None, fs: float | None = None, progress=None) -> Spectrum:
+    """Cross spectral density S_xy = E[conj(X) Y] (scipy's convention) between channels x and y."""
+    src, ix, iy, autos, cross, nseg, p = _pair_spectra(rec, x, y, nperseg, noverlap, window, detrend, nfft, fs,
+                                                        progress)
+    cx, cy = src.channels[ix], src.channels[iy]
+    unit = f"{cx.unit}*{cy.unit}/Hz" if cx.unit or cy.unit else "1/Hz"
+    return Spectrum(np.fft.rfftfreq(p["nfft"], 1 / src.fs), cross.conj(), "csd", unit, (f"{cx.name}*{cy.name}",),
+                    "unknown", dict(p, window=window, detrend=detrend, fs=src.fs, n_averages=nseg))
+
+
+def coherence(rec, x, y, *, nperseg: int | None = None, noverlap: int | None = None, window="hann",
+              detrend="constant", nfft: int | None = None, fs: float | None = None, progress=None) -> Spectrum:
+    """Magnitude-squared coherence |S_xy|^2 / (S_xx S_yy) between channels x and y (needs >= 2 averages)."""
+    src, ix, iy, autos, cross, nseg, p = _pair_spectra(rec, x, y, nperseg, noverlap, window, detrend, nfft, fs,
+                                                        progress)
+    if nseg < 2:
+        raise ParameterError(f"coherence needs at least 2 averages; nperseg={p['nperseg']} gives {nseg}: "
+                             "use a shorter nperseg")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c = np.abs(cross[0]) ** 2 / (autos[0] * autos[1])
+    c = np.where(np.isfinite(c), c, 0.0)
+    return Spectrum(np.fft.rfftfreq(p["nfft"], 1 / src.fs), c, "coherence", "",
+                    (f"{src.channels[ix].name}~{src.channels[iy].name}",), "unknown",
+                    dict(p, window=window, detrend=detrend, fs=src.fs, n_averages=nseg))
+
+
+def spectrogram(rec, *, channel=None, nperseg: int | None = None, noverlap: int | None = None, window="hann",
+                detrend="constant", nfft: int | None = None, fs: float | None = None) -> Spectrogram:
+    """Power spectral density of each segment over time (a waterfall): values (1, n_freq, n_times)."""
+    src = _source(rec, fs)
+    nperseg, noverlap, nfft = _check_params(src.n_samples, nperseg, noverlap, nfft, detrend, "mean", 1024)
+    idx = _channel_indices(src, 0 if channel is None else channel)
+    win = get_window(window, nperseg)
+    step = nperseg - noverlap
+    nseg = (src.n_samples - nperseg) // step + 1
+    if nseg * (nfft // 2 + 1) > MEDIAN_LIMIT:
+        raise ParameterError(f"spectrogram of {nseg} segments x {nfft // 2 + 1} lines is too large: "
+                             "raise nperseg or lower the overlap")
+    _, _, _, per = _segment_sums(src, idx, nperseg=nperseg, noverlap=noverlap, nfft=nfft, win=win,
+                                 detrend=detrend, keep_segments=True)
+    S = _one_sided(per / (src.fs * (win @ win)), nfft)  # (1, nseg, nf)
+    times = (np.arange(nseg) * step + nperseg / 2) / src.fs
+    ch, unit, _ = _meta(src, idx)
+    return Spectrogram(np.fft.rfftfreq(nfft, 1 / src.fs), times, np.transpose(S, (0, 2, 1)),
+                       power_unit(unit, density=True), (ch[0].name,),
+                       {"window": window, "nperseg": nperseg, "noverlap": noverlap, "nfft": nfft, "fs": src.fs})
+
+
+# ------------------------------------------------------------------------------------------------
+def _as_density(obj, fs=None, **kw) -> Spectrum:
+    if isinstance(obj, Spectrum):
+        if obj.kind != "psd":
+            raise ParameterError(f"band RMS needs a power spectral density (kind 'psd'), got kind {obj.kind!r}")
+        return obj
+    return psd(obj, fs=fs, **kw)
+
+
+def _band_power(spec: Spectrum, lo: float, hi: float) -> np.ndarray:
+    """Integral of a density over [lo, hi], each line covering +-df/2 and counted in part."""
+    f, df = spec.freq, spec.df
+    left = np.clip(f - df / 2, 0, None)
+    right = f + df / 2
+    frac = np.clip((np.minimum(right, hi) - np.maximum(left, lo)) / df, 0, 1)
+    return spec.values.real @ frac * df
+
+
+def band_rms(obj, band, *, fs: float | None = None, nperseg: int | None = None) -> np.ndarray:
+    """RMS of each channel in a frequency band (lo, hi) Hz, from its PSD (a Spectrum or a record).
+
+    Lines at the band edges count in part. ``band=(0, fs/2)`` gives the overall RMS less the mean.
+    """
+    spec = _as_density(obj, fs=fs, nperseg=nperseg)
+    lo, hi = _check_band(band, spec.params.get("fs", 2 * spec.freq[-1]))
+    return np.sqrt(_band_power(spec, lo, hi))
+
+
+def octave_bands(obj, *, fraction: int = 3, band=None, fs: float | None = None, nperseg: int | None = None):
+    """RMS in 1/1 or 1/3 octave bands (base-10 IEC 61260-1 mid-band frequencies), from the PSD.
+
+    Returns a pandas table: center_hz, lower_hz, upper_hz, lines (PSD lines inside the band: below 2
+    the band is narrower than the resolution) and one rms column per channel. Bands must lie
+    inside (df, fs/2) or ``band``.
+    """
+    import pandas as pd
+    if fraction not in (1, 3):
+        raise ParameterError(f"fraction={fraction!r} must be 1 (octave) or 3 (third octave)")
+    spec = _as_density(obj, fs=fs, nperseg=nperseg)
+    f_hi_lim = spec.freq[-1]
+    lo_lim, hi_lim = (spec.df, f_hi_lim) if band is None else _check_band(band, 2 * f_hi_lim)
+    G = 10 ** 0.3
+    rows = []
+    for x in range(-60, 60):
+        fm = 1000 * G ** (x / fraction)
+        fl, fu = fm * G ** (-1 / (2 * fraction)), fm * G ** (1 / (2 * fraction))
+        if fl < lo_lim or fu > hi_lim:
+            continue
+        pw = _band_power(spec, fl, fu)
+        rows.append({"center_hz": fm, "lower_hz": fl, "upper_hz": fu,
+                     "lines": int(np.sum((spec.freq >= fl) & (spec.freq < fu))),
+                     **{f"rms_{c}": float(np.sqrt(p)) for c, p in zip(spec.channels, pw)}})
+    if not rows:
+        raise ParameterError(f"no {'octave' if fraction == 1 else 'third-octave'} band fits between "
+                             f"{lo_lim:g} and {hi_lim:g} Hz")
+    return pd.DataFrame(rows)
