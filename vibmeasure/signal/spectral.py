@@ -22,7 +22,7 @@ from ..core.results import Spectrogram, Spectrum
 __all__ = ["amplitude_spectrum", "psd", "csd", "coherence", "spectrogram", "band_rms", "octave_bands",
            "power_unit", "get_window"]
 
-BATCH = 64              # segments transformed together: fits the cache, amortises call overhead
+BATCH = 32              # segments per channel transformed together: fits the cache, amortises call overhead
 READ_SAMPLES = 1 << 21  # samples per channel read from a lazy source at a time
 MEDIAN_LIMIT = 20_000_000  # per-segment values kept for median averaging
 
@@ -123,6 +123,8 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
                   reducer="sum", progress: Callable[[float], None] | None = None):
     """Sum (or max) over segments of |X|^2 per channel and of X_i conj(X_j) per pair.
 
+    Segments are strided views of blocks read from the source; each thread takes a share of a
+    block's segments in batches of BATCH per channel and keeps its own sums.
     Returns (autos (n_idx, nf), crosses (n_pairs, nf) complex, n_segments, per_segment or None).
     """
     n = src.n_samples
@@ -130,21 +132,53 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
     nseg = (n - nperseg) // step + 1
     nf = nfft // 2 + 1
     n_ch = len(idx)
-    autos = np.zeros((n_ch, nf)) if reducer == "sum" else np.full((n_ch, nf), -np.inf)
-    crosses = np.zeros((len(pairs), nf), complex)
     per_seg = np.empty((n_ch, nseg, nf)) if keep_segments else None
+    tt = None
     if detrend == "linear":
         tt = np.arange(nperseg) - (nperseg - 1) / 2
         tt = tt / np.sqrt(tt @ tt)
     sb = max(1, (READ_SAMPLES - nperseg) // step + 1)  # segments per read
     names = [c.name for c in src.channels]
-    done = 0
+    all_rows = list(idx) == list(range(src.n_channels))
+
+    def work(segs, lo, hi, s0):
+        au = np.zeros((n_ch, nf)) if reducer == "sum" else np.full((n_ch, nf), -np.inf)
+        cr = np.zeros((len(pairs), nf), complex)
+        for b0 in range(lo, hi, BATCH):
+            b1 = min(hi, b0 + BATCH)
+            Xs = []
+            for c in range(n_ch):
+                y = segs[c, b0:b1]
+                if detrend == "constant":
+                    y = y - y.mean(axis=-1, keepdims=True)
+                elif detrend == "linear":
+                    y = y - y.mean(axis=-1, keepdims=True)
+                    y = y - (y @ tt)[:, None] * tt
+                X = _fft.rfft(y * win, n=nfft, axis=-1)
+                P = X.real ** 2 + X.imag ** 2
+                if keep_segments:
+                    per_seg[c, s0 + b0:s0 + b1] = P
+                if reducer == "sum":
+                    au[c] += P.sum(axis=0)
+                else:
+                    np.maximum(au[c], P.max(axis=0), out=au[c])
+                if pairs:
+                    Xs.append(X)
+            for k, (i, j) in enumerate(pairs):
+                cr[k] += (Xs[i] * Xs[j].conj()).sum(axis=0)
+        return au, cr
+
+    autos = np.zeros((n_ch, nf)) if reducer == "sum" else np.full((n_ch, nf), -np.inf)
+    crosses = np.zeros((len(pairs), nf), complex)
+    pool = _pool()
     for s0 in range(0, nseg, sb):
         s1 = min(nseg, s0 + sb)
         a0 = s0 * step
         block = src.read(a0, (s1 - 1) * step + nperseg)
-        block = np.ascontiguousarray(block[idx], dtype=np.float64) if len(idx) != block.shape[0] or \
-            block.dtype != np.float64 or not block.flags.c_contiguous else block
+        if not all_rows:
+            block = block[idx]
+        if block.dtype != np.float64:
+            block = block.astype(np.float64)
         if not np.isfinite(block).all():
             bad = np.argwhere(~np.isfinite(block))[0]
             raise ParameterError(f"channel {names[idx[bad[0]]]!r} has NaN/inf at sample {a0 + bad[1]}; the rule is "
@@ -152,27 +186,37 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
         segs = np.lib.stride_tricks.as_strided(
             block, shape=(n_ch, s1 - s0, nperseg),
             strides=(block.strides[0], block.strides[1] * step, block.strides[1]), writeable=False)
-        for b0 in range(0, s1 - s0, BATCH):
-            y = segs[:, b0:b0 + BATCH]
-            if detrend == "constant":
-                y = y - y.mean(axis=-1, keepdims=True)
-            elif detrend == "linear":
-                y = y - y.mean(axis=-1, keepdims=True)
-                y = y - (y @ tt)[..., None] * tt
-            X = _fft.rfft(y * win, n=nfft, axis=-1)
-            P = X.real ** 2 + X.imag ** 2
-            if keep_segments:
-                per_seg[:, s0 + b0:s0 + b0 + P.shape[1]] = P
+        m = s1 - s0
+        if pool is None or m < 4 * BATCH:
+            parts = [work(segs, 0, m, s0)]
+        else:
+            cut = (m // 2 // BATCH) * BATCH
+            futs = [pool.submit(work, segs, 0, cut, s0), pool.submit(work, segs, cut, m, s0)]
+            parts = [f.result() for f in futs]
+        for au, cr in parts:
             if reducer == "sum":
-                autos += P.sum(axis=1)
+                autos += au
             else:
-                np.maximum(autos, P.max(axis=1), out=autos)
-            for k, (i, j) in enumerate(pairs):
-                crosses[k] += (X[i] * X[j].conj()).sum(axis=0)
-        done = s1
+                np.maximum(autos, au, out=autos)
+            crosses += cr
         if progress is not None:
-            progress(done / nseg)
+            progress(s1 / nseg)
     return autos, crosses, nseg, per_seg
+
+
+_POOL = None
+
+
+def _pool():
+    """Two worker threads (numpy and the FFT release the GIL) on machines with two or more cores."""
+    global _POOL
+    import os
+    if (os.cpu_count() or 1) < 2:
+        return None
+    if _POOL is None:
+        from concurrent.futures import ThreadPoolExecutor
+        _POOL = ThreadPoolExecutor(max_workers=2, thread_name_prefix="vibmeasure-fft")
+    return _POOL
 
 
 def _one_sided(a, nfft):
