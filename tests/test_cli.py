@@ -105,3 +105,45 @@ def test_force_channel_option_on_real_hammer_test(shared_data):
     assert min(abs(f - 34.06) for f in fns) < 0.01 and min(abs(f - 212.1) for f in fns) < 0.01
     code, _, err = run(["ringdown", str(shared_data("impact/case1.mat")), "--force", "hammer"])
     assert code == 2 and "'hammer' is not in this record" in err
+
+
+# --- spectrum -----------------------------------------------------------------------------------
+def test_spectrum_json_peaks_on_machine_sample(sample_dir):
+    code, out, err = run(["spectrum", str(sample_dir / "machine.h5"), "--json", "--peaks", "6"])
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["kind"] == "amplitude" and doc["unit"] == "g" and doc["df_hz"] == pytest.approx(0.25)
+    pk = doc["peaks"]["acc_de"]
+    top = {round(p["freq_hz"], 2): p["amplitude"] for p in pk}
+    # synthesised: 0.08 g at 29.95 Hz, 0.03 g at 2X, 0.05 g at 1200 Hz with 0.01 g sidebands (+-1X)
+    assert top[29.95] == pytest.approx(0.08, rel=0.01) and top[1200.0] == pytest.approx(0.05, rel=0.01)
+    assert {1170.05, 1229.95} <= set(top)
+
+
+def test_spectrum_psd_csv_and_plot(sample_dir, tmp_path):
+    csv, png = tmp_path / "psd.csv", tmp_path / "psd.png"
+    code, out, err = run(["spectrum", str(sample_dir / "machine.h5"), "--kind", "psd", "--nperseg", "2048",
+                          "--band", "10", "200", "--csv", str(csv), "--plot", str(png)])
+    assert code == 0, err
+    import pandas as pd
+    tab = pd.read_csv(csv)
+    assert list(tab.columns) == ["freq_hz", "acc_de"] and tab.freq_hz.min() >= 10 and tab.freq_hz.max() <= 200
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_spectrum_envelope_needs_band(sample_dir):
+    code, _, err = run(["spectrum", str(sample_dir / "machine.h5"), "--kind", "envelope"])
+    assert code == 2 and "band=(lo, hi) is required" in err
+    code, out, _ = run(["spectrum", str(sample_dir / "machine.h5"), "--kind", "envelope", "--band", "1000", "1400",
+                        "--json", "--peaks", "1"])
+    assert code == 0
+    assert json.loads(out)["peaks"]["acc_de.env"][0]["freq_hz"] == pytest.approx(29.95, abs=0.05)
+
+
+def test_spectrum_errors_and_progress(sample_dir, monkeypatch, tmp_path):
+    code, _, err = run(["spectrum", str(sample_dir / "machine.h5"), "--kind", "psd", "--nperseg", "100000"])
+    assert code == 2 and "exceeds the record length" in err
+    import vibmeasure.cli as cli
+    monkeypatch.setattr(cli._Progress.__init__, "__defaults__", (0.0,))  # show at once
+    code, _, err = run(["spectrum", str(sample_dir / "machine.h5"), "--kind", "psd", "--nperseg", "256"])
+    assert code == 0 and "psd [" in err and "100%" in err
