@@ -9,8 +9,10 @@ from . import synth
 from .core import units
 from .core.errors import FitError, ParameterError, QualityWarning, UnitError, VibMeasureError
 from .core.record import Channel, Record
-from .core.results import ModalEstimate, Peaks, Spectrogram, Spectrum
+from .core.results import FRF, ModalEstimate, Peaks, Spectrogram, Spectrum
 from .identify.damping import half_power, hilbert_decay, log_decrement, zeta_from_delta
+from .identify.frf import estimate_frf, find_hits, impact_frf
+from .identify.modal import circle_fit, fit_modes, mac, modal_crb, synthesize_frf
 from .identify.ringdown import ringdown, ringdown_crb
 from .io import LazyRecord, read, write
 from .io import open_record as open  # noqa: A001  (vm.open: the documented name)
@@ -23,12 +25,13 @@ from .signal.spectral import amplitude_spectrum, band_rms, coherence, csd, octav
 __version__ = "0.1.0"
 
 __all__ = [
-    "Channel", "Record", "LazyRecord", "ModalEstimate", "Spectrum", "Spectrogram", "Peaks",
+    "Channel", "Record", "LazyRecord", "ModalEstimate", "FRF", "Spectrum", "Spectrogram", "Peaks",
     "VibMeasureError", "ParameterError", "UnitError", "FitError", "QualityWarning",
     "read", "write", "open",
     "amplitude_spectrum", "psd", "csd", "coherence", "spectrogram", "band_rms", "octave_bands",
     "pick_peaks", "harmonic_family", "sideband_family", "envelope", "envelope_spectrum",
     "detrend", "filter", "decimate", "resample", "integrate", "differentiate",
-    "ringdown", "ringdown_crb", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
+    "ringdown", "ringdown_crb", "estimate_frf", "impact_frf", "find_hits", "fit_modes", "circle_fit", "mac",
+    "modal_crb", "synthesize_frf", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
     "synth", "units", "__version__",
 ]

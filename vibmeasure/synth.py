@@ -177,3 +177,57 @@ def coulomb_decay(*, fn: float, friction_decay: float, fs: float, duration: floa
     return _finish(x, t, fs=fs, quantity=quantity, unit=unit, snr_db=snr_db, noise_std=noise_std,
                    ref_amp=abs(amplitude) * wn ** order, clip=None, dc_offset=0.0, drift=0.0, seed=seed,
                    name=name, truth=truth)
+
+
+def _modal_args(fn, zeta, shapes, input_dof):
+    fn = np.atleast_1d(np.asarray(fn, float))
+    zeta = np.broadcast_to(np.atleast_1d(np.asarray(zeta, float)), fn.shape).copy()
+    phi = np.asarray(shapes, float)
+    if phi.ndim != 2 or phi.shape[1] != fn.size:
+        raise ParameterError(f"shapes must be (n_dof, n_modes={fn.size}) mass-normalised mode shapes, got {phi.shape}")
+    if not 0 <= input_dof < phi.shape[0]:
+        raise ParameterError(f"input_dof={input_dof} is not a dof of the {phi.shape[0]}-dof shapes")
+    if np.any(fn <= 0) or np.any(zeta < 0) or np.any(zeta >= 1):
+        raise ParameterError("fn must be > 0 and 0 <= zeta < 1 for every mode")
+    return fn, zeta, phi
+
+
+def modal_frf(freq, *, fn, zeta, shapes, input_dof: int = 0, form: str = "receptance"):
+    """Analytic FRFs of a proportionally damped system from its modes (a closed-form oracle).
+
+    H_p,in(w) = sum_r phi_pr phi_in,r / (w_r^2 - w^2 + 2 i zeta_r w_r w) (receptance), times i w or
+    -w^2 for mobility or accelerance. ``shapes`` (n_dof, n_modes) mass-normalised.
+    """
+    from .core.results import FRF
+    freq = np.asarray(freq, float)
+    fn, zeta, phi = _modal_args(fn, zeta, shapes, input_dof)
+    w = 2 * np.pi * freq
+    wr = 2 * np.pi * fn
+    den = wr[:, None] ** 2 - w[None] ** 2 + 2j * zeta[:, None] * wr[:, None] * w[None]  # (modes, nf)
+    h = np.einsum("pr,r,rf->pf", phi, phi[input_dof], 1 / den)
+    k = {"receptance": 0, "mobility": 1, "accelerance": 2}[form]
+    h = h * (1j * w) ** k
+    return FRF(freq, h[:, None, :], form, estimator="analytic",
+               outputs=tuple(f"dof{p}" for p in range(phi.shape[0])), inputs=(f"dof{input_dof}",))
+
+
+def modal_response(force, *, fs: float, fn, zeta, shapes, input_dof: int = 0, quantity: str = "displacement"):
+    """Responses (n_dof, n) of a proportionally damped system to a force sampled at ``fs``.
+
+    Each mode is discretised exactly for a force held between samples (zero-order hold), so the
+    discrete poles are exp(lambda_r / fs) exactly; outputs sum phi_pr q_r (or its derivatives).
+    """
+    from scipy.signal import cont2discrete, lfilter
+    force = np.asarray(force, float)
+    fn, zeta, phi = _modal_args(fn, zeta, shapes, input_dof)
+    order = _ORDER.get(quantity)
+    if order is None:
+        raise ParameterError(f"quantity={quantity!r} must be one of {tuple(_ORDER)}")
+    out = np.zeros((phi.shape[0], force.size))
+    for r in range(fn.size):
+        wr = 2 * np.pi * fn[r]
+        num = [1.0] + [0.0] * order
+        b, a, _ = cont2discrete((num, [1.0, 2 * zeta[r] * wr, wr ** 2]), 1 / fs, method="zoh")
+        q = lfilter(np.ravel(b), a, phi[input_dof, r] * force)
+        out += np.outer(phi[:, r], q)
+    return out

@@ -1,0 +1,263 @@
+"""FRF estimation: H1, H2 and Hv from random or impact excitation, with coherence and random error.
+
+The cross-spectral sums come from the same blocked engine as vm.psd (so H1 and the coherence equal
+what scipy.signal.csd/welch give for the same segments). Impact tests are cut into one record per
+hit; a force window keeps the pulse and an exponential window (on force and response alike, so
+the estimate is exactly the FRF of the system with every pole moved left by 1/tau) tames leakage;
+fit_modes then removes that added damping exactly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core._validate import as_record
+from ..core.errors import ParameterError, warn_quality
+from ..core.record import Record
+from ..core.results import FRF
+from ..signal.spectral import _check_params, _segment_sums, get_window
+from ._decay import clipped_mask
+
+__all__ = ["estimate_frf", "impact_frf", "find_hits", "form_of"]
+
+_FORM = {"displacement": "receptance", "velocity": "mobility", "acceleration": "accelerance"}
+DOUBLE_HIT = 0.2   # a second pulse above 20 % of the first after it has ended is a double hit
+
+
+def form_of(quantity: str) -> str:
+    """FRF form for an output quantity (acceleration -> accelerance); 'unknown' otherwise."""
+    return _FORM.get(quantity, "unknown")
+
+
+def _io(rec: Record, input, outputs):
+    if input is None:
+        raise ParameterError("input is required: a channel name, or 'force' for the force channel(s)")
+    ins = [input] if isinstance(input, (str, int)) else list(input)
+    if ins == ["force"] and "force" not in rec.names:
+        ins = [c.name for c in rec.channels if c.quantity == "force"]
+        if not ins:
+            raise ParameterError(f"input='force' but no channel of {rec.names} has quantity 'force'; name the "
+                                 "input channel or read the file with its quantities")
+    ii = [rec.index(c) for c in ins]
+    for i in ii:
+        c = rec.channels[i]
+        if c.quantity not in ("force", "unknown", "voltage"):
+            raise ParameterError(f"input channel {c.name!r} measures {c.quantity}, not force: an FRF divides "
+                                 "response by force")
+    if outputs is None:
+        oo = [i for i in range(rec.n_channels) if i not in ii]
+    else:
+        oo = [rec.index(c) for c in ([outputs] if isinstance(outputs, (str, int)) else outputs)]
+    if not oo:
+        raise ParameterError("no output channel: the record holds only the input(s)")
+    if set(oo) & set(ii):
+        raise ParameterError("a channel cannot be both input and output")
+    return ii, oo
+
+
+def _h_from_sums(Gxx, Gyx, Gyy, estimator, n_in):
+    """H (n_out, n_in, nf), coherence (n_out, nf) from averaged spectral sums."""
+    n_out, nf = Gyy.shape
+    if estimator == "H1":
+        if n_in == 1:
+            H = (Gyx[:, 0] / Gxx[0, 0])[:, None]
+        else:
+            H = np.einsum("oif->fio", Gyx)  # (nf, n_in, n_out) for the solve
+            Gxx_f = np.transpose(Gxx, (2, 1, 0))  # (nf, j, i): solve X^T
+            # H Gxx = Gyx  ->  Gxx^T H^T = Gyx^T
+            H = np.linalg.solve(Gxx_f, H)
+            H = np.transpose(H, (2, 1, 0))
+    else:
+        if n_in != 1:
+            raise ParameterError(f"estimator={estimator!r} needs a single input; with {n_in} inputs use 'H1'")
+        gxx, gyx = Gxx[0, 0], Gyx[:, 0]
+        if estimator == "H2":
+            H = (Gyy / gyx.conj())[:, None]
+        else:  # Hv: total least squares, equal noise on input and output
+            d = Gyy - gxx
+            H = ((d + np.sqrt(d ** 2 + 4 * np.abs(gyx) ** 2)) / (2 * gyx.conj()))[:, None]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        if n_in == 1:
+            coh = np.abs(Gyx[:, 0]) ** 2 / (Gxx[0, 0].real * Gyy)
+        else:  # multiple coherence: Gyx Gxx^-1 Gxy / Gyy
+            Gxx_f = np.transpose(Gxx, (2, 0, 1))
+            g = np.transpose(Gyx, (2, 0, 1))  # (nf, n_out, n_in)
+            sol = np.linalg.solve(Gxx_f, np.conj(np.transpose(g, (0, 2, 1))))  # Gxx^-1 Gxy
+            coh = np.real(np.einsum("foi,fio->fo", g, sol)).T / Gyy
+    coh = np.clip(np.where(np.isfinite(coh), coh.real, 0.0), 0.0, 1.0)
+    return H, coh
+
+
+def _random_error(coh, n_avg):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e = np.sqrt(1 - coh) / (np.sqrt(coh) * np.sqrt(2 * n_avg))
+    return np.where(np.isfinite(e), e, np.inf)
+
+
+def estimate_frf(rec, *, input="force", outputs=None, estimator: str = "H1", nperseg: int | None = None,
+                 noverlap: int | None = None, window="hann", detrend="constant", fs: float | None = None,
+                 progress=None) -> FRF:
+    """FRFs from input (force) and output records by segment averaging.
+
+    ``estimator``: "H1" (noise on the output; MIMO by Gyx Gxx^-1), "H2" (noise on the input) or
+    "Hv" (equal noise on both; single input). Returns an :class:`FRF` whose form follows the
+    output quantity, with ordinary (one input) or multiple coherence and the normalised random
+    error of |H| = sqrt(1 - coh) / (sqrt(coh) sqrt(2 n_avg)). At least 2 averages are required.
+    """
+    rec = as_record(rec, fs=fs)
+    if estimator not in ("H1", "H2", "Hv"):
+        raise ParameterError(f"estimator={estimator!r} must be 'H1', 'H2' or 'Hv'")
+    ii, oo = _io(rec, input, outputs)
+    nperseg, noverlap, nfft = _check_params(rec.n_samples, nperseg, noverlap, None, detrend, "mean",
+                                            min(rec.n_samples // 4, 4096) or 2)
+    win = get_window(window, nperseg)
+    idx = ii + oo
+    n_in, n_out = len(ii), len(oo)
+    pairs = [(a, b) for a in range(n_in) for b in range(n_in)] + \
+            [(n_in + o, a) for o in range(n_out) for a in range(n_in)]
+
+    class _Src:  # the record seen by the engine
+        fs, channels, n_samples, n_channels = rec.fs, rec.channels, rec.n_samples, rec.n_channels
+
+        @staticmethod
+        def read(a, b):
+            return rec.data[:, a:b]
+    autos, cross, nseg, _ = _segment_sums(_Src, idx, nperseg=nperseg, noverlap=noverlap, nfft=nfft, win=win,
+                                          detrend=detrend, pairs=pairs, progress=progress)
+    if nseg < 2:
+        raise ParameterError(f"nperseg={nperseg} gives {nseg} average: coherence and H need at least 2; "
+                             "use a shorter nperseg or a longer record")
+    nf = nfft // 2 + 1
+    Gxx = cross[: n_in * n_in].reshape(n_in, n_in, nf) / nseg
+    Gyx = cross[n_in * n_in:].reshape(n_out, n_in, nf) / nseg
+    Gyy = autos[n_in:] / nseg
+    H, coh = _h_from_sums(Gxx, Gyx, Gyy, estimator, n_in)
+    outs = [rec.channels[i] for i in oo]
+    forms = {form_of(c.quantity) for c in outs}
+    form = forms.pop() if len(forms) == 1 else "unknown"
+    err = np.broadcast_to(_random_error(coh, nseg)[:, None, :], H.shape).copy()
+    unit = f"{outs[0].unit}/{rec.channels[ii[0]].unit}" if outs[0].unit and rec.channels[ii[0]].unit else ""
+    return FRF(np.fft.rfftfreq(nfft, 1 / rec.fs), H, form, coh, estimator, tuple(c.name for c in outs),
+               tuple(rec.channels[i].name for i in ii), unit, err,
+               {"window": window, "nperseg": nperseg, "noverlap": noverlap, "n_averages": nseg, "fs": rec.fs,
+                "detrend": detrend})
+
+
+def find_hits(force, fs: float, *, threshold: float = 0.1, min_gap_s: float | None = None) -> np.ndarray:
+    """Sample indices where hammer hits start: rising crossings of threshold x the largest peak,
+    at least ``min_gap_s`` apart (default 0.1 s)."""
+    f = np.asarray(force, float)
+    if not np.isfinite(f).all():
+        raise ParameterError("the force channel has NaN/inf samples")
+    if not 0 < threshold < 1:
+        raise ParameterError(f"threshold={threshold} must be between 0 and 1 (fraction of the largest peak)")
+    base = np.median(f)
+    a = np.abs(f - base)
+    peak = a.max()
+    if peak == 0:
+        raise ParameterError("the force channel is constant: no hit")
+    above = a > threshold * peak
+    starts = np.flatnonzero(above[1:] & ~above[:-1]) + 1
+    if above[0]:
+        starts = np.r_[0, starts]
+    gap = int(round((0.1 if min_gap_s is None else min_gap_s) * fs))
+    hits = []
+    for s in starts:
+        if not hits or s - hits[-1] >= gap:
+            hits.append(s)
+    return np.asarray(hits, int)
+
+
+def impact_frf(rec, *, input="force", outputs=None, record_length: float | None = None,
+               pretrigger: float = 0.005, exp_window="auto", force_window: bool = True, estimator: str = "H1",
+               threshold: float = 0.1, fs: float | None = None) -> FRF:
+    """FRFs from a hammer test: one record per hit, averaged (H1 by default).
+
+    Each hit starts ``pretrigger`` s before the force crosses ``threshold`` of its peak and lasts
+    ``record_length`` s (default: up to the next hit, at most the shortest spacing). The force
+    window keeps the pulse (zero beyond twice its duration); the exponential window exp(-t/tau)
+    (``"auto"``: 1 % at the record end, a number: tau in s, None: off) is applied to force and
+    response, so each pole moves left by exactly 1/tau; the FRF carries tau and fit_modes removes
+    it. Double hits (a second pulse above 20 % after the first ended) and clipping are flagged
+    (params["flags"], QualityWarning); clean single hits are not.
+    """
+    rec = as_record(rec, fs=fs)
+    ii, oo = _io(rec, input, outputs)
+    if len(ii) != 1:
+        raise ParameterError("impact_frf takes one force input (the hammer)")
+    fsr = rec.fs
+    force = rec.data[ii[0]]
+    hits = find_hits(force, fsr, threshold=threshold)
+    pre = int(round(pretrigger * fsr))
+    spacing = np.diff(hits)
+    if record_length is None:
+        n = int(spacing.min()) if spacing.size else rec.n_samples - max(0, hits[0] - pre)
+    else:
+        n = int(round(record_length * fsr))
+    starts = hits - pre
+    ok = (starts >= 0) & (starts + n <= rec.n_samples)
+    starts = starts[ok]
+    if starts.size == 0:
+        raise ParameterError(f"no hit has {n} samples after it (record_length={n / fsr:g} s): shorten it")
+    if n < 16:
+        raise ParameterError(f"record_length gives {n} samples per hit: too short")
+    t = np.arange(n) / fsr
+    flags = []
+    if exp_window is None:
+        tau = None
+        ew = np.ones(n)
+    else:
+        tau = (t[-1] / np.log(100.0)) if exp_window == "auto" else float(exp_window)
+        if not np.isfinite(tau) or tau <= 0:
+            raise ParameterError(f"exp_window={exp_window!r} must be 'auto', None or a time constant > 0 s")
+        ew = np.exp(-np.clip(t - pre / fsr, 0, None) / tau)
+    nf = n // 2 + 1
+    n_out = len(oo)
+    Sxx = np.zeros(nf)
+    Syx = np.zeros((n_out, nf), complex)
+    Syy = np.zeros((n_out, nf))
+    double, clipped = [], False
+    for k, s in enumerate(starts):
+        fseg = force[s:s + n] - np.median(force[s:s + max(pre, 1)]) if pre > 0 else force[s:s + n].copy()
+        a = np.abs(fseg)
+        ip = int(np.argmax(a))
+        low = a < 0.05 * a[ip]
+        pe = ip + (int(np.argmax(low[ip:])) if low[ip:].any() else n - ip)  # pulse end
+        ps = ip - (int(np.argmax(low[ip::-1])) if low[ip::-1].any() else ip)  # pulse start
+        dur = max(pe - ps, 1)
+        after = a[pe + dur:]
+        if after.size and after.max() > DOUBLE_HIT * a[ip]:
+            double.append(k)
+        if clipped_mask(rec.data[ii[0], s:s + n]).any() or any(clipped_mask(rec.data[o, s:s + n]).any() for o in oo):
+            clipped = True
+        if force_window:  # keep the pulse (and the pre-trigger), zero what follows: noise, not force
+            fseg = fseg.copy()
+            fseg[min(n, pe + dur):] = 0.0
+        X = np.fft.rfft(fseg * ew)
+        Sxx += np.abs(X) ** 2
+        for j, o in enumerate(oo):
+            yseg = rec.data[o, s:s + n] - np.mean(rec.data[o, s:s + max(pre, 1)])
+            Y = np.fft.rfft(yseg * ew)
+            Syx[j] += Y * X.conj()
+            Syy[j] += np.abs(Y) ** 2
+    if double:
+        flags.append("double_hit")
+    if clipped:
+        flags.append("clipped")
+    navg = starts.size
+    Gxx = Sxx[None, None]
+    H, coh = _h_from_sums(Gxx.astype(complex), Syx[:, None], Syy, estimator, 1)
+    if navg < 2:
+        coh = np.ones_like(coh)  # a single hit gives no coherence estimate
+        flags.append("single_average")
+    outs = [rec.channels[i] for i in oo]
+    forms = {form_of(c.quantity) for c in outs}
+    err = np.broadcast_to(_random_error(coh, navg)[:, None, :], H.shape).copy()
+    frf = FRF(np.fft.rfftfreq(n, 1 / fsr), H, forms.pop() if len(forms) == 1 else "unknown", coh, estimator,
+              tuple(c.name for c in outs), (rec.channels[ii[0]].name,), "", err,
+              {"window": "force+exponential" if tau else ("force" if force_window else "boxcar"), "nperseg": n,
+               "n_averages": int(navg), "fs": fsr, "exp_window_tau_s": tau, "hits_s": (starts + pre) / fsr,
+               "double_hits": double, "flags": tuple(flags)})
+    if flags and flags != ["single_average"]:
+        warn_quality(f"impact_frf: {', '.join(flags)}" + (f" (hits {double})" if double else ""), stacklevel=3)
+    return frf

@@ -1,0 +1,554 @@
+"""Modal identification from FRFs: half-power (exact forms), circle fit, and fit_modes
+(LSCF poles with an automatic stabilisation diagram, then a maximum-likelihood polish of poles and
+residues with lower/upper residual terms, with standard deviations from the Fisher information).
+
+Model per output o (one input): H_o(w) = sum_r [R_or / (i w - l_r) + conj(R_or) / (i w - conj(l_r))]
++ c1_o / (i w)^2 + c2_o + c3_o (i w), poles l_r = -sigma_r + i w_dr. With complex Gaussian noise of
+variance s_o^2 per output, weighted least squares is maximum likelihood.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core._validate import check_band
+from ..core.errors import FitError, ParameterError, warn_quality
+from ..core.results import FRF, ModalEstimate, Spectrum
+
+__all__ = ["fit_modes", "half_power_frf", "circle_fit", "mac", "synthesize_frf", "modal_crb"]
+
+STABLE_DF = 0.01     # pole frequency within 1 % of one at the previous order
+STABLE_DZ = 0.05     # and damping within 5 %
+MIN_LINES_OK = 10    # half-power bandwidth spanned by fewer lines: resolution-limited
+MIN_LINES_WINDOWED = 8
+
+
+# ------------------------------------------------------------------------------------------------
+def _band_lines(frf: FRF, band, inp):
+    if not isinstance(frf, FRF):
+        raise ParameterError(f"frf must be a vm.FRF, got {type(frf).__name__}")
+    if band is None:
+        raise ParameterError("band=(lo, hi) in Hz is required: the frequency range to fit")
+    lo, hi = check_band(band, 2 * frf.freq[-1] + 1e-9)
+    if hi > frf.freq[-1] + 1e-9 or lo < frf.freq[0] - 1e-9:
+        raise ParameterError(f"band={band!r} lies outside the FRF's {frf.freq[0]:g}..{frf.freq[-1]:g} Hz")
+    ii = frf.inputs.index(inp) if isinstance(inp, str) else int(inp)
+    if not 0 <= ii < frf.n_inputs:
+        raise ParameterError(f"input={inp!r} is not in this FRF; it has {list(frf.inputs)}")
+    sel = (frf.freq >= lo) & (frf.freq <= hi) & (frf.freq > 0)
+    H = frf.h[:, ii, sel]
+    bad = ~np.isfinite(H).all(axis=0)
+    if bad.any():
+        raise ParameterError(f"the FRF has {int(bad.sum())} NaN/inf line(s) in band={band!r} (first at "
+                             f"{frf.freq[sel][bad][0]:g} Hz): cut the band or repair the data")
+    if sel.sum() < 8:
+        raise ParameterError(f"band={band!r} holds {int(sel.sum())} lines; at least 8 are needed")
+    return frf.freq[sel], H, ii, (lo, hi)
+
+
+# --- LSCF and stabilisation -------------------------------------------------------------------
+def _lscf_poles(f, H, max_order):
+    """Poles for every even order up to max_order (reduced normal equations, least-squares complex
+    frequency domain, common denominator)."""
+    w = 2 * np.pi * f
+    dt = 1 / (2 * f[-1])
+    Om = np.exp(-1j * w * dt)
+    n = max_order
+    X = Om[:, None] ** np.arange(n + 1)
+    Rs, Ss, Ts = [], [], []
+    for o in range(H.shape[0]):
+        # each line weighted by 1/(smooth trend of |H|): the equation error becomes about relative,
+        # so a weak mode (high frequency in a receptance) counts as much as a strong one, while
+        # noisy anti-resonances (where |H| itself is near zero) are not blown up
+        lf = np.log(f)
+        trend = np.polyval(np.polyfit(lf, np.log(np.maximum(np.abs(H[o]), 1e-300)), 2), lf)
+        wt = np.exp(-trend)
+        Xw = X * wt[:, None]
+        Y = -(H[o] * wt)[:, None] * X
+        Rs.append(np.real(Xw.conj().T @ Xw))
+        Ss.append(np.real(Xw.conj().T @ Y))
+        Ts.append(np.real(Y.conj().T @ Y))
+    out = {}
+    for order in range(2, n + 1, 2):
+        k = order + 1
+        M = np.zeros((k, k))
+        for R, S, T in zip(Rs, Ss, Ts):
+            M += T[:k, :k] - S[:k, :k].T @ np.linalg.solve(R[:k, :k], S[:k, :k])
+        try:
+            a = np.r_[-np.linalg.solve(M[:order, :order], M[:order, order]), 1.0]
+        except np.linalg.LinAlgError:
+            continue
+        z = np.roots(a[::-1])
+        z = z[np.abs(z) > 0]
+        lam = -np.log(z) / dt
+        lam = lam[(lam.imag > 0) & (lam.real < 0)]
+        fp = np.abs(lam) / (2 * np.pi)
+        keep = (fp >= f[0]) & (fp <= f[-1])
+        out[order] = lam[keep]
+    return out
+
+
+def _stabilise(poles_by_order):
+    """Label poles stable against the previous order; cluster stable poles across orders."""
+    orders = sorted(poles_by_order)
+    table = []  # (order, f, zeta, status) with status 'o' new, 'f' frequency, 's' stable
+    stable = []
+    prev = None
+    for n in orders:
+        lam = poles_by_order[n]
+        for l in lam:
+            f, z = abs(l) / (2 * np.pi), -l.real / abs(l)
+            status = "o"
+            if prev is not None and prev.size:
+                fp = np.abs(prev) / (2 * np.pi)
+                zp = -prev.real / np.abs(prev)
+                j = int(np.argmin(np.abs(fp - f)))
+                if abs(fp[j] - f) <= STABLE_DF * f:
+                    status = "f"
+                    if abs(zp[j] - z) <= STABLE_DZ * z:
+                        status = "s"
+                    # frequency-stable poles form the clusters: in noise a true mode's damping
+                    # scatters across orders by more than 5 %, its frequency does not
+                    stable.append((n, l))
+            table.append((n, f, z, status))
+        prev = lam
+    clusters = []
+    for n, l in sorted(stable, key=lambda p: abs(p[1])):
+        f = abs(l) / (2 * np.pi)
+        if clusters and abs(f - clusters[-1]["f"]) <= STABLE_DF * f:
+            c = clusters[-1]
+            c["poles"].append(l)
+            c["orders"].add(n)
+            c["f"] = float(np.median(np.abs(c["poles"]))) / (2 * np.pi)
+        else:
+            clusters.append({"f": f, "poles": [l], "orders": {n}})
+    return table, clusters
+
+
+# --- the maximum-likelihood polish ----------------------------------------------------------------
+def _basis(w, lam):
+    """Complex basis columns (n_lines, 2 m + 6) for real coefficients: modes (u, v) and residuals."""
+    iw = 1j * w
+    cols = []
+    for l in lam:
+        a = 1 / (iw - l)
+        b = 1 / (iw - np.conj(l))
+        cols += [a + b, 1j * (a - b)]
+    cols += [1 / iw ** 2, 1j / iw ** 2, np.ones_like(iw), 1j * np.ones_like(iw), iw, 1j * iw]
+    return np.column_stack(cols)
+
+
+def _real(B):
+    return np.vstack([B.real, B.imag])
+
+
+def _lam(theta):
+    return -theta[0::2] + 1j * theta[1::2]
+
+
+def _varpro(theta, w, Hw):
+    """Weighted residual of the best linear fit for fixed poles (all outputs share the basis)."""
+    A = _real(_basis(w, _lam(theta)))
+    Y = np.vstack([Hw.real.T, Hw.imag.T])  # (2 nf, n_out), already divided by each output's noise std
+    coef, *_ = np.linalg.lstsq(A, Y, rcond=None)
+    return (Y - A @ coef).ravel(order="F"), coef
+
+
+def _full_jacobian(w, theta, coef, sw):
+    """Jacobian of the weighted real residual model w.r.t. (sigma, wd per mode) and all linear
+    coefficients (``coef`` unweighted, one column per output); rows stacked as in _varpro."""
+    lam = _lam(theta)
+    m = lam.size
+    iw = 1j * w
+    B = _basis(w, lam)
+    n_out = coef.shape[1]
+    P_nl = 2 * m
+    P_lin = B.shape[1]
+    nf = w.size
+    J = np.zeros((2 * nf * n_out, P_nl + P_lin * n_out))
+    for o in range(n_out):
+        rows = slice(2 * nf * o, 2 * nf * (o + 1))
+        c = coef[:, o]
+        for r, l in enumerate(lam):
+            R = c[2 * r] + 1j * c[2 * r + 1]
+            da = R / (iw - l) ** 2          # d/d lambda
+            db = np.conj(R) / (iw - np.conj(l)) ** 2
+            d_sigma = -(da + db)             # lambda = -sigma + i wd
+            d_wd = 1j * da - 1j * db
+            J[rows, 2 * r] = np.r_[d_sigma.real, d_sigma.imag] * sw[o]
+            J[rows, 2 * r + 1] = np.r_[d_wd.real, d_wd.imag] * sw[o]
+        J[rows, P_nl + P_lin * o:P_nl + P_lin * (o + 1)] = _real(B) * sw[o]
+    return J
+
+
+def _polish(w, H, lam0, sw):
+    from scipy.optimize import least_squares
+    theta0 = np.column_stack([-lam0.real, lam0.imag]).ravel()
+    Hw = H * sw[:, None]
+    fun = lambda th: _varpro(th, w, Hw)[0]  # noqa: E731
+    lb = np.tile([1e-9, w[0] * 0.5], lam0.size)
+    ub = np.tile([np.inf, w[-1] * 1.5], lam0.size)
+    theta0 = np.clip(theta0, lb + 1e-12, ub)
+    sol = least_squares(fun, theta0, bounds=(lb, ub), x_scale=np.abs(theta0) + 1e-9, xtol=1e-12, ftol=1e-12,
+                        gtol=1e-12, method="trf")
+    r, coef = _varpro(sol.x, w, Hw)
+    return sol.x, coef, r
+
+
+DETECT_FRF = 30.0  # a mode found in the residual must lower the weighted residual sum of squares this much
+
+
+def _residual_search(w, H, theta, coef, r, sw, n_modes, max_add=4):
+    """Add modes that the stabilisation missed (weak ones, near the noise): where the weighted
+    residual, summed over outputs and a few lines, stands out of its chi-square level, start a pole
+    there and keep it if the fit improves by more than DETECT_FRF (or while n_modes asks for more)."""
+    n_out, nf = H.shape
+    added = 0
+    for _ in range(max_add):
+        m = theta.size // 2
+        if n_modes is not None and m >= n_modes:
+            break
+        res = r.reshape(n_out, 2, nf)
+        e = np.sum(res[:, 0] ** 2 + res[:, 1] ** 2, axis=0)  # per line, about 2 n_out / 2 = n_out on average
+        s2 = float(np.mean(e)) / n_out if np.mean(e) > 0 else 1.0
+        e = e / s2
+        win = 5
+        ms = np.convolve(e, np.ones(win), mode="same")
+        k = int(np.argmax(ms))
+        expect = n_out * win
+        if n_modes is None and ms[k] < expect + 5 * np.sqrt(expect):
+            break
+        wk = w[k]
+        if np.any(np.abs(theta[1::2] - wk) < 2 * (w[1] - w[0])):
+            break
+        z0 = max(2 * (w[1] - w[0]) / wk, 0.005)
+        lam_new = np.r_[_lam(theta), -z0 * wk + 1j * wk]
+        rss_old = float(r @ r)
+        th2, c2, r2 = _polish(w, H, lam_new, sw)
+        gain = (rss_old - float(r2 @ r2)) / (rss_old / max(r.size - coef.size - theta.size, 1))
+        if n_modes is None and gain < DETECT_FRF:
+            break
+        theta, coef, r = th2, c2, r2
+        added += 1
+    return theta, coef, r, added
+
+
+def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None, input=0) -> ModalEstimate:
+    """Natural frequencies, damping ratios and mode shapes from FRFs in ``band`` (Hz).
+
+    LSCF poles for orders 2..max_order build an automatic stabilisation diagram; poles stable in
+    frequency (1 %) and damping (5 %) are clustered across orders and the clusters seen at enough
+    orders are the modes (or the ``n_modes`` most persistent). Poles, complex residues and residual
+    terms (1/(iw)^2, constant, iw per output) are then fitted by weighted nonlinear least squares
+    (maximum likelihood for complex Gaussian noise, each output weighted by its residual noise),
+    giving fn, zeta and their standard deviations from the Fisher information. An exponential
+    window from vm.impact_frf is removed exactly (sigma - 1/tau). ``extras`` holds poles,
+    residues, the stabilisation table, the synthesised FRFs' correlation (FRAC) and the mode shapes
+    are in ``shapes`` (n_outputs, n_modes), unit-normalised (mass-normalised when an output is the
+    driving point).
+    """
+    f, H, ii, band = _band_lines(frf, band, input)
+    if isinstance(max_order, bool) or not isinstance(max_order, (int, np.integer)) or not 4 <= max_order <= 200:
+        raise ParameterError(f"max_order={max_order!r} must be an integer from 4 to 200")
+    if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer))
+                                or n_modes < 1):
+        raise ParameterError(f"n_modes={n_modes!r} must be None or an integer >= 1")
+    poles = _lscf_poles(f, H, max_order)
+    table, clusters = _stabilise(poles)
+    n_orders = len(poles)
+    need = max(3, int(0.25 * n_orders))
+    good = [c for c in clusters if len(c["orders"]) >= need]
+    good.sort(key=lambda c: -len(c["orders"]))
+    if n_modes is not None:
+        good = (good if len(good) >= n_modes else sorted(clusters, key=lambda c: -len(c["orders"])))[:n_modes]
+    if not good:
+        raise FitError(f"no stable mode in band={band!r}: no pole persists across model orders (the band holds "
+                       "no resonance, or only noise)")
+    lam0 = np.array([np.median(np.array(c["poles"])[np.argsort(-np.array(sorted(c["orders"])))][:5]) for c in good])
+    lam0 = lam0[np.argsort(np.abs(lam0))]
+    w = 2 * np.pi * f
+    # first pass with equal relative weights, then weights from each output's residual noise
+    sw = 1 / np.sqrt(np.mean(np.abs(H) ** 2, axis=1))
+    theta, coef, r = _polish(w, H, lam0, sw)
+    nf = f.size
+    P_lin = coef.shape[0]
+    res = r.reshape(H.shape[0], 2 * nf)
+    s_o = np.sqrt(np.sum(res ** 2, axis=1) / max(2 * nf - P_lin - 2 * lam0.size / H.shape[0], 1)) / sw
+    sw = 1 / np.maximum(s_o, 1e-300)
+    theta, coef, r = _polish(w, H, _lam(theta), sw)
+    theta, coef, r, added = _residual_search(w, H, theta, coef, r, sw, n_modes)
+    J = _full_jacobian(w, theta, coef / sw[None, :], sw)  # unweighted coefficients
+    dof = max(r.size - J.shape[1], 1)
+    s2 = float(r @ r) / dof
+    try:
+        cov = s2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        cov = s2 * np.linalg.pinv(J.T @ J)
+    lam = _lam(theta)
+    m = lam.size
+    tau = frf.params.get("exp_window_tau_s")
+    sig = theta[0::2].copy()
+    if tau:
+        sig = sig - 1.0 / tau  # the exponential window moved every pole left by exactly 1/tau
+    wd = theta[1::2]
+    wn = np.hypot(sig, wd)
+    fn = wn / (2 * np.pi)
+    zeta = sig / wn
+    fn_std, zeta_std = np.empty(m), np.empty(m)
+    for k in range(m):
+        c2 = cov[2 * k:2 * k + 2, 2 * k:2 * k + 2]
+        g_wn = np.array([sig[k], wd[k]]) / wn[k]
+        g_z = np.array([wd[k] ** 2, -sig[k] * wd[k]]) / wn[k] ** 3
+        fn_std[k] = np.sqrt(max(g_wn @ c2 @ g_wn, 0)) / (2 * np.pi)
+        zeta_std[k] = np.sqrt(max(g_z @ c2 @ g_z, 0))
+    # residues (n_out, m) in the FRF's own units (undo the weights)
+    R = (coef[0:2 * m:2] + 1j * coef[1:2 * m:2]).T / sw[:, None]
+    flags_mode, keep = [], []
+    df = float(np.median(np.diff(f)))
+    windowed = str(frf.params.get("window", "boxcar")) not in ("boxcar", "rectangular", "force+exponential",
+                                                                "force", "None")
+    for k in range(m):
+        fl = []
+        if not (np.isfinite(zeta[k]) and zeta[k] > 0 and fn[k] > 0):
+            continue  # negative or no damping: not a mode (reported in extras, never returned)
+        lines = 2 * zeta[k] * fn[k] / df
+        if frf.estimator != "analytic" and lines < (MIN_LINES_WINDOWED if windowed else 3):
+            fl.append("resolution_limited")
+        if frf.coherence is not None:
+            near = np.abs(frf.freq - fn[k]) <= max(zeta[k] * fn[k], df)
+            if near.any() and np.mean(frf.coherence[:, near]) < 0.8:
+                fl.append("low_coherence")
+        others = [j for j in range(m) if j != k]
+        if any(abs(fn[j] - fn[k]) < 3 * (zeta[j] * fn[j] + zeta[k] * fn[k]) for j in others):
+            fl.append("close_modes")
+        flags_mode.append(tuple(fl))
+        keep.append(k)
+    dropped = [{"fn_hz": float(fn[k]), "zeta": float(zeta[k])} for k in range(m) if k not in keep]
+    if not keep:
+        raise FitError(f"every pole found in band={band!r} has zero or negative damping: no physical mode")
+    keep = np.array(keep)
+    shapes = R[:, keep].copy()
+    dp = [o for o, name in enumerate(frf.outputs) if name == frf.inputs[ii]]
+    for j in range(keep.size):
+        col = shapes[:, j]
+        if dp and abs(col[dp[0]]) > 0:
+            # receptance residue R_pq = phi_p phi_q / (2 i wd): phi = R_pq / sqrt(R_qq 2 i wd)... normalised
+            col = col * np.sqrt(2j * wd[keep[j]]) / np.sqrt(col[dp[0]] * 2j * wd[keep[j]]) if frf.form == \
+                "receptance" else col / np.sqrt(col[dp[0]])
+        else:
+            col = col / col[np.argmax(np.abs(col))]
+        shapes[:, j] = col
+    Hs = synthesize_frf_from(f, lam, R, coef, sw, m)
+    frac = [float(np.abs(np.vdot(Hs[o], H[o])) ** 2 / (np.vdot(H[o], H[o]).real * np.vdot(Hs[o], Hs[o]).real))
+            for o in range(H.shape[0])]
+    extras = {"poles": [[float(l.real), float(l.imag)] for l in lam[keep]],
+              "residues": [[[float(x.real), float(x.imag)] for x in R[:, k]] for k in keep],
+              "band_hz": list(band), "frac": frac, "noise_std_per_output": list(1 / sw),
+              "stabilisation": table, "n_orders": n_orders, "exp_window_tau_s": tau,
+              "exp_window_added_zeta": [float(1 / (tau * wn[k])) for k in keep] if tau else None,
+              "dropped_poles": dropped, "outputs": list(frf.outputs), "input": frf.inputs[ii], "form": frf.form}
+    est = ModalEstimate(fn=fn[keep], zeta=zeta[keep], fn_std=fn_std[keep], zeta_std=zeta_std[keep],
+                        method="fit_modes", mode_flags=tuple(flags_mode), shapes=shapes, extras=extras)
+    warn = [fl for fl in est.flags if fl in ("resolution_limited", "low_coherence")]
+    if warn or dropped:
+        msg = ", ".join(warn)
+        if "resolution_limited" in warn:
+            msg += " (half-power bandwidth spans too few lines: window leakage biases zeta upwards)"
+        if dropped:
+            msg += f"; {len(dropped)} pole(s) with zero or negative damping left out"
+        warn_quality(f"fit_modes: {msg.strip('; ')}", stacklevel=2)
+    return est
+
+
+def synthesize_frf_from(f, lam, R, coef, sw, m):
+    w = 2 * np.pi * f
+    B = _basis(w, lam)
+    return (B @ coef).T / sw[:, None]
+
+
+def synthesize_frf(est: ModalEstimate, freq) -> np.ndarray:
+    """Modal part of the FRFs (n_outputs, n_freq) from a fit_modes estimate's poles and residues."""
+    if "poles" not in est.extras or "residues" not in est.extras:
+        raise ParameterError("est must come from vm.fit_modes (it needs poles and residues)")
+    w = 2 * np.pi * np.asarray(freq, float)
+    iw = 1j * w
+    out = 0
+    for (re, im), res in zip(est.extras["poles"], est.extras["residues"]):
+        l = re + 1j * im
+        R = np.array([a + 1j * b for a, b in res])
+        out = out + R[:, None] / (iw - l) + np.conj(R)[:, None] / (iw - np.conj(l))
+    return np.asarray(out)
+
+
+def mac(a, b=None) -> np.ndarray:
+    """Modal assurance criterion between the columns of a and b (n_dof, n_modes): |a^H b|^2 / (|a|^2 |b|^2)."""
+    a = np.asarray(a, complex)
+    b = a if b is None else np.asarray(b, complex)
+    if a.ndim != 2 or b.ndim != 2 or a.shape[0] != b.shape[0]:
+        raise ParameterError(f"mac needs two (n_dof, n_modes) arrays with equal n_dof, got {a.shape} and {b.shape}")
+    num = np.abs(a.conj().T @ b) ** 2
+    den = np.outer(np.sum(np.abs(a) ** 2, 0), np.sum(np.abs(b) ** 2, 0))
+    return num / den
+
+
+def modal_crb(freq, *, fn, zeta, residues, noise_std) -> dict:
+    """Cramer-Rao bound on fn and zeta for FRFs in complex Gaussian noise (std noise_std per output,
+    E|n|^2 = s^2), from the Fisher information of the modal model with complex residues (the same
+    parameters fit_modes estimates, residual terms included). Returns fn_std, zeta_std arrays."""
+    f = np.asarray(freq, float)
+    f = f[f > 0]
+    w = 2 * np.pi * f
+    fn = np.atleast_1d(np.asarray(fn, float))
+    zeta = np.atleast_1d(np.asarray(zeta, float))
+    R = np.asarray(residues, complex)  # (n_out, m)
+    wn = 2 * np.pi * fn
+    sig, wd = zeta * wn, wn * np.sqrt(1 - zeta ** 2)
+    theta = np.column_stack([sig, wd]).ravel()
+    sw = 1 / (np.asarray(noise_std, float) / np.sqrt(2))  # real and imaginary parts each s / sqrt 2
+    coef = np.zeros((2 * fn.size + 6, R.shape[0]))
+    coef[0:2 * fn.size:2] = R.real.T
+    coef[1:2 * fn.size:2] = R.imag.T
+    J = _full_jacobian(w, theta, coef, sw)
+    cov = np.linalg.inv(J.T @ J)
+    fn_std, zeta_std = [], []
+    for k in range(fn.size):
+        c2 = cov[2 * k:2 * k + 2, 2 * k:2 * k + 2]
+        g_wn = np.array([sig[k], wd[k]]) / wn[k]
+        g_z = np.array([wd[k] ** 2, -sig[k] * wd[k]]) / wn[k] ** 3
+        fn_std.append(np.sqrt(g_wn @ c2 @ g_wn) / (2 * np.pi))
+        zeta_std.append(np.sqrt(g_z @ c2 @ g_z))
+    return {"fn_std": np.array(fn_std), "zeta_std": np.array(zeta_std)}
+
+
+# ------------------------------------------------------------------------------------------------
+def _zeta_from_points(w1, w2, form):
+    if form == "mobility":
+        zeta = (w2 - w1) / (2 * np.sqrt(w1 * w2))
+        wn = np.sqrt(w1 * w2)
+        return zeta, wn
+    rho = (w2 ** 2 - w1 ** 2) / (w2 ** 2 + w1 ** 2)
+    zeta = np.sqrt(0.5 * (1 - 1 / np.sqrt(1 + rho ** 2)))
+    if form == "accelerance":
+        wn = np.sqrt(2 * (1 - 2 * zeta ** 2) / (1 / w1 ** 2 + 1 / w2 ** 2))
+    else:
+        wn = np.sqrt((w1 ** 2 + w2 ** 2) / (2 * (1 - 2 * zeta ** 2)))
+    return zeta, wn
+
+
+def half_power_frf(obj, *, band=None, output=0, input=0) -> ModalEstimate:
+    """Half-power bandwidth of one FRF (or a magnitude spectrum) peak, with the exact relations.
+
+    Mobility: zeta = (f2 - f1) / (2 sqrt(f1 f2)). Receptance and accelerance: with
+    rho = (f2^2 - f1^2) / (f2^2 + f1^2), zeta = sqrt((1 - 1/sqrt(1 + rho^2)) / 2) (exact for one
+    mode; (f2 - f1)/(2 f_peak) would overestimate by about 2 zeta^2 and 4 zeta^2). Crossings are
+    interpolated in |H|^2. Refused when the lower half-power point does not exist (zeta > 0.38) or
+    the bandwidth spans fewer than 3 lines; flagged below 10 lines and when another peak is near.
+    A spectrum is treated as accelerance when it measures acceleration, else as receptance.
+    """
+    if isinstance(obj, FRF):
+        o = obj.outputs.index(output) if isinstance(output, str) else output
+        i = obj.inputs.index(input) if isinstance(input, str) else input
+        freq, P, form = obj.freq, np.abs(obj.h[o, i]) ** 2, obj.form
+        coh = obj.coherence[o] if obj.coherence is not None else None
+    elif isinstance(obj, Spectrum):
+        freq = obj.freq
+        ch = obj.channels.index(output) if isinstance(output, str) else output
+        v = np.abs(obj.values[ch])
+        P = v if obj.kind in ("psd", "power") else v ** 2
+        form = "accelerance" if obj.quantity == "acceleration" else "receptance"
+        coh = None
+    else:
+        raise ParameterError(f"half_power takes a vm.FRF, a vm.Spectrum or a ring-down vm.Record, "
+                             f"got {type(obj).__name__}")
+    if form == "unknown":
+        form = "receptance"
+    if not np.isfinite(P).all():
+        raise ParameterError("the FRF/spectrum has NaN/inf lines")
+    sel = np.ones(freq.size, bool) if band is None else (freq >= band[0]) & (freq <= band[1])
+    sel &= freq > 0
+    if not sel.any():
+        raise ParameterError(f"band={band!r} holds no line of the data")
+    k = int(np.flatnonzero(sel)[np.argmax(P[sel])])
+    half = P[k] / 2
+    lo = k
+    while lo > 0 and P[lo] > half:
+        lo -= 1
+    hi = k
+    while hi < P.size - 1 and P[hi] > half:
+        hi += 1
+    if P[lo] > half or freq[lo] <= 0 or lo == 0 and P[0] > half:
+        raise FitError("half_power: the lower half-power point does not exist (zeta > 0.38, or the peak sits "
+                       "at the start of the data)")
+    if P[hi] > half:
+        raise FitError("half_power: the upper half-power point lies beyond the data")
+    f1 = freq[lo] + (half - P[lo]) * (freq[lo + 1] - freq[lo]) / (P[lo + 1] - P[lo])
+    f2 = freq[hi - 1] + (half - P[hi - 1]) * (freq[hi] - freq[hi - 1]) / (P[hi] - P[hi - 1])
+    df = float(freq[1] - freq[0])
+    lines = (f2 - f1) / df
+    if lines < 3:
+        raise FitError(f"half_power: the half-power bandwidth spans {lines:.2g} lines (< 3): the resolution "
+                       f"({df:.4g} Hz) cannot measure zeta; use vm.fit_modes or a finer resolution")
+    zeta, wn = _zeta_from_points(2 * np.pi * f1, 2 * np.pi * f2, form)
+    flags = []
+    if lines < MIN_LINES_OK:
+        flags.append("resolution_limited")
+    # another peak within three bandwidths?
+    bw = f2 - f1
+    near = (np.abs(freq - freq[k]) > bw) & (np.abs(freq - freq[k]) < 3 * bw + bw)
+    if near.any():
+        idx = np.flatnonzero(near)
+        loc = [j for j in idx if 0 < j < P.size - 1 and P[j] >= P[j - 1] and P[j] >= P[j + 1] and P[j] > 0.25 * P[k]]
+        if loc:
+            flags.append("close_modes")
+    if coh is not None and np.mean(coh[lo:hi + 1]) < 0.8:
+        flags.append("low_coherence")
+    est = ModalEstimate(fn=[wn / (2 * np.pi)], zeta=[zeta], fn_std=[np.nan], zeta_std=[np.nan], method="halfpower",
+                        flags=tuple(flags), extras={"f1_hz": float(f1), "f2_hz": float(f2), "lines": float(lines),
+                                                    "form": form, "peak_hz": float(freq[k]),
+                                                    "std": "the half-power method gives no statistical std"})
+    if flags:
+        warn_quality(f"half_power: {', '.join(flags)} ({lines:.3g} lines across the half-power band)", stacklevel=3)
+    return est
+
+
+def circle_fit(frf: FRF, *, band, output=0, input=0) -> ModalEstimate:
+    """SDOF circle fit (Kennedy-Pancu) on the mobility around one peak in ``band``.
+
+    The mobility of a mode traces a circle; fn is where the angle sweeps fastest and
+    zeta = (wb^2 - wa^2) / (2 wn^2 (tan(theta_a/2) + tan(theta_b/2))) averaged over point pairs.
+    """
+    if not isinstance(frf, FRF):
+        raise ParameterError(f"frf must be a vm.FRF, got {type(frf).__name__}")
+    lo, hi = check_band(band, 2 * frf.freq[-1] + 1e-9)
+    mob = frf.to("mobility") if frf.form in ("receptance", "accelerance") else frf
+    o = frf.outputs.index(output) if isinstance(output, str) else output
+    i = frf.inputs.index(input) if isinstance(input, str) else input
+    sel = (frf.freq >= lo) & (frf.freq <= hi) & (frf.freq > 0)
+    if sel.sum() < 6:
+        raise FitError(f"circle_fit: band={band!r} holds {int(sel.sum())} lines; at least 6 are needed")
+    f = frf.freq[sel]
+    h = mob.h[o, i, sel]
+    x, y = h.real, h.imag
+    A = np.column_stack([x, y, np.ones_like(x)])
+    c, *_ = np.linalg.lstsq(A, -(x ** 2 + y ** 2), rcond=None)
+    xc, yc = -c[0] / 2, -c[1] / 2
+    rad = np.sqrt(xc ** 2 + yc ** 2 - c[2])
+    ang = np.unwrap(np.angle((x - xc) + 1j * (y - yc)))
+    w = 2 * np.pi * f
+    rate = np.abs(np.diff(ang) / np.diff(w ** 2))
+    j = int(np.argmax(rate))
+    wn = np.sqrt(0.5 * (w[j] ** 2 + w[j + 1] ** 2))
+    # angle from the resonance point (diametrically opposite the circle's touch at the origin side)
+    a_n = 0.5 * (ang[j] + ang[j + 1])
+    zs = []
+    for a_idx in range(0, j + 1):
+        for b_idx in range(j + 1, f.size):
+            ta, tb = abs(ang[a_idx] - a_n), abs(ang[b_idx] - a_n)
+            if 0.2 < ta < 2.5 and 0.2 < tb < 2.5:
+                zs.append((w[b_idx] ** 2 - w[a_idx] ** 2) / (2 * wn ** 2 * (np.tan(ta / 2) + np.tan(tb / 2))))
+    if not zs:
+        raise FitError("circle_fit: too few points on either side of the resonance in band")
+    zeta = float(np.median(zs))
+    return ModalEstimate(fn=[wn / (2 * np.pi)], zeta=[zeta], fn_std=[np.nan],
+                         zeta_std=[float(np.std(zs) / np.sqrt(len(zs)))], method="circle",
+                         extras={"center": [float(xc), float(yc)], "radius": float(rad)})
