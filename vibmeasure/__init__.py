@@ -14,7 +14,7 @@ from .identify.damping import half_power, hilbert_decay, log_decrement, zeta_fro
 from .identify.frf import estimate_frf, find_hits, impact_frf
 from .identify.modal import circle_fit, fit_modes, mac, modal_crb, synthesize_frf
 from .identify.ringdown import ringdown, ringdown_crb
-from .io import LazyRecord, read, write
+from .io import LazyRecord, read, read_frf, read_spectrum, write
 from .io import open_record as open  # noqa: A001  (vm.open: the documented name)
 from .signal.demod import envelope, envelope_spectrum
 from .signal.peaks import harmonic_family, pick_peaks, sideband_family
@@ -27,7 +27,7 @@ __version__ = "0.1.0"
 __all__ = [
     "Channel", "Record", "LazyRecord", "ModalEstimate", "FRF", "Spectrum", "Spectrogram", "Peaks",
     "VibMeasureError", "ParameterError", "UnitError", "FitError", "QualityWarning",
-    "read", "write", "open",
+    "read", "write", "open", "read_frf", "read_spectrum",
     "amplitude_spectrum", "psd", "csd", "coherence", "spectrogram", "band_rms", "octave_bands",
     "pick_peaks", "harmonic_family", "sideband_family", "envelope", "envelope_spectrum",
     "detrend", "filter", "decimate", "resample", "integrate", "differentiate",

@@ -62,7 +62,117 @@ def _parser() -> argparse.ArgumentParser:
     sp.add_argument("--csv", metavar="OUT.csv", help="write the spectrum as a table")
     sp.add_argument("--json", action="store_true", help="print one JSON document")
     sp.add_argument("--plot", metavar="OUT.png", help="write a picture of the spectrum and its peaks")
+
+    for name, helptext in (("frf", "frequency response functions from force and response records"),
+                           ("modes", "natural frequencies, damping and shapes from FRFs (fit_modes)")):
+        q = sub.add_parser(name, help=helptext, description=helptext + "; FILE may hold time data or FRFs "
+                                                                    "(UFF 58 function type 4).")
+        q.add_argument("file", help="record (.csv .h5 .wav .mat .lvm .uff) or FRF file (.uff)")
+        q.add_argument("--input", default="force", help="input (force) channel name (default: the force channel)")
+        q.add_argument("--output", action="append", help="output channel(s) (default: all others)")
+        q.add_argument("--estimator", choices=("H1", "H2", "Hv"), default="H1")
+        q.add_argument("--window", default="hann", help="window for random excitation (default hann)")
+        q.add_argument("--nperseg", type=int, help="segment length for random excitation")
+        q.add_argument("--impact", action="store_true", help="hammer test: one record per hit, force and "
+                                                            "exponential windows (added damping removed)")
+        q.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
+        q.add_argument("--variable", help="MATLAB variable holding a complex FRF (e.g. Hf_chan_2)")
+        if name == "modes":
+            q.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"), required=True,
+                           help="frequency band to fit (Hz)")
+            q.add_argument("--modes", type=int, help="number of modes (default: from the stabilisation diagram)")
+            q.add_argument("--max-order", type=int, default=40, help="highest LSCF model order (default 40)")
+        q.add_argument("--json", action="store_true", help="print one JSON document")
+        q.add_argument("--plot", metavar="OUT.png", help="write a picture (Bode + coherence, or the "
+                                                         "stabilisation diagram for modes)")
     return p
+
+
+def _get_frf(args):
+    from . import io
+    from .identify import frf as F
+    p = Path(args.file)
+    if args.variable or (p.suffix.lower() in (".uff", ".unv") and _uff_has_frf(p)):
+        return io.read_frf(p, variable=args.variable)
+    rec = io.read(p, fs=args.fs)
+    if args.input not in rec.names and args.input != "force":
+        raise VibMeasureError(f"--input {args.input!r} is not in the file; channels are {rec.names}")
+    if args.input in rec.names:
+        import dataclasses
+        i = rec.index(args.input)
+        chans = list(rec.channels)
+        if chans[i].quantity != "force":
+            chans[i] = dataclasses.replace(chans[i], quantity="force", unit="")
+            rec = rec.replace(channels=tuple(chans), note=f"channel {args.input!r} marked as force")
+    if args.impact:
+        return F.impact_frf(rec, input=args.input, outputs=args.output, estimator=args.estimator)
+    return F.estimate_frf(rec, input=args.input, outputs=args.output, estimator=args.estimator,
+                          window=args.window, nperseg=args.nperseg)
+
+
+def _uff_has_frf(p):
+    from .io.uff import _sets
+    return any(int(d.get("func_type", 0)) == 4 for d in _sets(p))
+
+
+def _main_frf(args, out, err) -> int:
+    import numpy as np
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", QualityWarning)
+        try:
+            frf = _get_frf(args)
+            est = None
+            if args.command == "modes":
+                from .identify.modal import fit_modes
+                est = fit_modes(frf, band=tuple(args.band), n_modes=args.modes, max_order=args.max_order)
+            if args.plot:
+                import matplotlib
+                matplotlib.use("Agg")
+                import matplotlib.pyplot as plt
+                from .plot import plot_frf, plot_stabilisation
+                if est is not None:
+                    ax = plot_stabilisation(est, frf=frf)
+                    fig = ax.figure
+                else:
+                    fig = plot_frf(frf)[0].figure
+                try:
+                    _atomic_savefig(fig, args.plot)
+                finally:
+                    plt.close(fig)
+        except (VibMeasureError, OSError) as exc:
+            print(f"vibmeasure: error: {exc}", file=err)
+            return 2
+    msgs = [str(w.message) for w in caught if issubclass(w.category, QualityWarning)]
+    from .core.results import _jsonable
+    coh = None if frf.coherence is None else [float(np.mean(c)) for c in frf.coherence]
+    info = {"form": frf.form, "estimator": frf.estimator, "outputs": list(frf.outputs), "inputs": list(frf.inputs),
+            "df_hz": frf.df, "n_lines": int(frf.freq.size), "n_averages": frf.params.get("n_averages"),
+            "mean_coherence": coh, "exp_window_tau_s": frf.params.get("exp_window_tau_s"),
+            "frf_flags": list(frf.params.get("flags", ()))}
+    if args.json:
+        doc = {"command": args.command, "file": str(args.file), **_jsonable(info), "warnings": msgs}
+        if est is not None:
+            d = est.to_dict()
+            extras = {k: v for k, v in d["extras"].items() if k not in ("stabilisation",)}
+            doc.update({"method": d["method"], "flags": d["flags"], "modes": d["modes"], "extras": extras})
+        json.dump(doc, out, indent=2, allow_nan=False)
+        out.write("\n")
+    else:
+        print(f"{args.file}  FRF {frf.form} ({frf.estimator}), {frf.n_outputs} output(s), df {frf.df:.4g} Hz, "
+              f"{info['n_averages']} averages", file=out)
+        if coh:
+            print("mean coherence: " + ", ".join(f"{o} {c:.3f}" for o, c in zip(frf.outputs, coh)), file=out)
+        if est is not None:
+            print(f"{'mode':>4}  {'fn [Hz]':>12}  {'± std':>10}  {'zeta':>10}  {'± std':>9}  flags", file=out)
+            for i in range(est.n_modes):
+                m = est.mode(i)
+                print(f"{i + 1:>4}  {m['fn_hz']:12.6g}  {m['fn_std_hz']:10.2g}  {m['zeta']:10.5g}  "
+                      f"{m['zeta_std']:9.2g}  {','.join(m['flags'])}", file=out)
+    for m in msgs:
+        print(f"vibmeasure: warning: {m}", file=err)
+    if args.plot:
+        print(f"vibmeasure: wrote {args.plot}", file=err)
+    return 0
 
 
 class _Progress:
@@ -224,6 +334,8 @@ def main(argv=None, *, out=None, err=None) -> int:
     args = _parser().parse_args(argv)
     if args.command == "spectrum":
         return _main_spectrum(args, out, err)
+    if args.command in ("frf", "modes"):
+        return _main_frf(args, out, err)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", QualityWarning)
         try:

@@ -13,7 +13,8 @@ from .core.errors import ParameterError
 from .core.record import Record
 from .core.results import ModalEstimate
 
-__all__ = ["plot_ringdown", "plot_spectrum", "decay_model"]
+__all__ = ["plot_ringdown", "plot_spectrum", "plot_frf", "plot_nyquist", "plot_stabilisation", "plot_mac",
+           "decay_model"]
 
 
 def decay_model(est: ModalEstimate, t: np.ndarray) -> np.ndarray:
@@ -110,4 +111,102 @@ def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: b
     ax.set_title(f"{spec.kind}: window {spec.params.get('window', '?')}, nperseg {spec.params.get('nperseg', '?')}, "
                  f"df {spec.df:.4g} Hz, {spec.params.get('n_averages', 1)} averages", fontsize=9)
     ax.legend(loc="upper right", fontsize=8)
+    return ax
+
+
+def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
+    """Bode plot (magnitude, phase) of one FRF with its coherence, and the FRF synthesised from
+    a fit_modes estimate when given. Returns (magnitude, phase, coherence) axes."""
+    import matplotlib.pyplot as plt
+    from .core.results import FRF
+    if not isinstance(frf, FRF):
+        raise ParameterError(f"frf must be a vm.FRF, got {type(frf).__name__}")
+    o = frf.outputs.index(output) if isinstance(output, str) else output
+    i = frf.inputs.index(input) if isinstance(input, str) else input
+    if axes is None:
+        fig, axes = plt.subplots(3, 1, sharex=True, figsize=(9, 7), gridspec_kw={"height_ratios": [3, 1.5, 1]})
+    am, ap, ac = axes
+    h = frf.h[o, i]
+    am.semilogy(frf.freq, np.abs(h), lw=0.8, label=f"{frf.outputs[o]}/{frf.inputs[i]} ({frf.estimator or 'data'})")
+    ap.plot(frf.freq, np.degrees(np.angle(h)), lw=0.8)
+    if est is not None and "poles" in est.extras:
+        from .identify.modal import synthesize_frf
+        band = est.extras.get("band_hz", (frf.freq[0], frf.freq[-1]))
+        sel = (frf.freq >= band[0]) & (frf.freq <= band[1]) & (frf.freq > 0)
+        hs = synthesize_frf(est, frf.freq[sel])
+        if est.extras.get("outputs") and frf.outputs[o] in est.extras["outputs"]:
+            k = est.extras["outputs"].index(frf.outputs[o])
+            am.semilogy(frf.freq[sel], np.abs(hs[k]), "--", lw=0.9, label="synthesised (modes only)")
+        for f in est.fn:
+            am.axvline(f, color="0.6", lw=0.5, ls=":")
+    if frf.coherence is not None:
+        ac.plot(frf.freq, frf.coherence[o], lw=0.8, color="C2")
+    ac.set_ylim(0, 1.05)
+    am.set_ylabel(f"|H| {frf.form}")
+    ap.set_ylabel("phase [deg]")
+    ac.set_ylabel("coherence")
+    ac.set_xlabel("frequency [Hz]")
+    am.legend(fontsize=8)
+    return am, ap, ac
+
+
+def plot_nyquist(frf, *, output=0, input=0, band=None, ax=None):
+    """Nyquist plot (real vs imaginary) of one FRF, optionally within a band."""
+    import matplotlib.pyplot as plt
+    if ax is None:
+        _, ax = plt.subplots(figsize=(5.5, 5.5))
+    o = frf.outputs.index(output) if isinstance(output, str) else output
+    i = frf.inputs.index(input) if isinstance(input, str) else input
+    sel = np.ones(frf.freq.size, bool) if band is None else (frf.freq >= band[0]) & (frf.freq <= band[1])
+    h = frf.h[o, i, sel]
+    ax.plot(h.real, h.imag, ".-", ms=3, lw=0.6)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("real")
+    ax.set_ylabel("imaginary")
+    ax.set_title(f"Nyquist: {frf.outputs[o]}/{frf.inputs[i]} ({frf.form})", fontsize=9)
+    return ax
+
+
+def plot_stabilisation(est, *, frf=None, ax=None):
+    """The stabilisation diagram of a fit_modes estimate: poles per model order (o new, f stable in
+    frequency, s stable in frequency and damping), the chosen modes, and |H| behind it."""
+    import matplotlib.pyplot as plt
+    if "stabilisation" not in est.extras:
+        raise ParameterError("est must come from vm.fit_modes (it carries the stabilisation table)")
+    if ax is None:
+        _, ax = plt.subplots(figsize=(9, 5))
+    tab = est.extras["stabilisation"]
+    style = {"o": dict(marker="o", color="0.7", ms=3, ls=""), "f": dict(marker="d", color="C1", ms=3, ls=""),
+             "s": dict(marker="x", color="C0", ms=4, ls="")}
+    for key, label in (("o", "new"), ("f", "stable f"), ("s", "stable f, zeta")):
+        pts = [(f, n) for n, f, z, s in tab if s == key]
+        if pts:
+            ax.plot(*zip(*pts), label=label, **style[key])
+    for f in est.fn:
+        ax.axvline(f, color="C3", lw=0.8)
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("model order")
+    if frf is not None:
+        ax2 = ax.twinx()
+        ax2.semilogy(frf.freq, np.abs(frf.h).mean(axis=(0, 1)), color="0.3", lw=0.6)
+        ax2.set_ylabel("mean |H|")
+    ax.legend(loc="upper left", fontsize=8)
+    ax.set_title("stabilisation diagram (red: chosen modes)", fontsize=9)
+    return ax
+
+
+def plot_mac(matrix, *, labels=None, ax=None):
+    """MAC matrix as an image with the values written in."""
+    import matplotlib.pyplot as plt
+    m = np.asarray(matrix, float)
+    if ax is None:
+        _, ax = plt.subplots(figsize=(4.5, 4))
+    im = ax.imshow(m, vmin=0, vmax=1, cmap="Blues")
+    for (r, c), v in np.ndenumerate(m):
+        ax.text(c, r, f"{v:.2f}", ha="center", va="center", fontsize=8, color="w" if v > 0.6 else "k")
+    if labels is not None:
+        ax.set_xticks(range(len(labels)), labels)
+        ax.set_yticks(range(len(labels)), labels)
+    ax.figure.colorbar(im, ax=ax, fraction=0.046)
+    ax.set_title("MAC", fontsize=9)
     return ax

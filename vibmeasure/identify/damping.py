@@ -243,7 +243,8 @@ def hilbert_decay(rec, *, channel=None, band=None, start: float | None = None,
 
 
 def half_power(obj, *, band=None, channel=None, start: float | None = None, fs: float | None = None) -> ModalEstimate:
-    """Half-power bandwidth of the ring-down spectrum (one mode).
+    """Half-power bandwidth: of an FRF or spectrum peak (exact relations per form, see
+    :func:`vibmeasure.identify.modal.half_power_frf`), or of the ring-down spectrum of a Record.
 
     The decay's power spectrum (zero-padded 16x, no window: the decay itself ends the record)
     is a Lorentzian about the damped frequency whose half-power points lie at wd +- sigma, so
@@ -252,6 +253,10 @@ def half_power(obj, *, band=None, channel=None, start: float | None = None, fs: 
     widens the peak. The method gives no statistical std (NaN).
     """
     from ..core.record import Record
+    from ..core.results import FRF, Spectrum
+    if isinstance(obj, (FRF, Spectrum)):
+        from .modal import half_power_frf
+        return half_power_frf(obj, band=band, output=0 if channel is None else channel)
     if not isinstance(obj, (Record, np.ndarray, list, tuple)):
         raise ParameterError(f"obj must be a ring-down Record (or array with fs), got {type(obj).__name__}")
     rec, idx, x, band, flags, i0, _ = _prepare(obj, channel, None, start, fs)

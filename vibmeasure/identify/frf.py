@@ -189,9 +189,10 @@ def impact_frf(rec, *, input="force", outputs=None, record_length: float | None 
     force = rec.data[ii[0]]
     hits = find_hits(force, fsr, threshold=threshold)
     pre = int(round(pretrigger * fsr))
+    pre = min(pre, int(hits[0]))  # a hit at the very start leaves less pre-trigger
     spacing = np.diff(hits)
     if record_length is None:
-        n = int(spacing.min()) if spacing.size else rec.n_samples - max(0, hits[0] - pre)
+        n = int(spacing.min()) if spacing.size else rec.n_samples - (hits[0] - pre)
     else:
         n = int(round(record_length * fsr))
     starts = hits - pre

@@ -309,8 +309,8 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
                                                                 "force", "None")
     for k in range(m):
         fl = []
-        if not (np.isfinite(zeta[k]) and zeta[k] > 0 and fn[k] > 0):
-            continue  # negative or no damping: not a mode (reported in extras, never returned)
+        if not (np.isfinite(zeta[k]) and 0 < zeta[k] < 0.5 and band[0] <= fn[k] <= band[1]):
+            continue  # no/negative damping, over-damped or outside the band: reported in extras, never returned
         lines = 2 * zeta[k] * fn[k] / df
         if frf.estimator != "analytic" and lines < (MIN_LINES_WINDOWED if windowed else 3):
             fl.append("resolution_limited")
@@ -318,14 +318,16 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
             near = np.abs(frf.freq - fn[k]) <= max(zeta[k] * fn[k], df)
             if near.any() and np.mean(frf.coherence[:, near]) < 0.8:
                 fl.append("low_coherence")
-        others = [j for j in range(m) if j != k]
-        if any(abs(fn[j] - fn[k]) < 3 * (zeta[j] * fn[j] + zeta[k] * fn[k]) for j in others):
-            fl.append("close_modes")
-        flags_mode.append(tuple(fl))
+        flags_mode.append(fl)
         keep.append(k)
+    for a, k in enumerate(keep):  # close modes among the physical ones
+        if any(abs(fn[j] - fn[k]) < 3 * (zeta[j] * fn[j] + zeta[k] * fn[k]) for j in keep if j != k):
+            flags_mode[a].append("close_modes")
+    flags_mode = [tuple(f) for f in flags_mode]
     dropped = [{"fn_hz": float(fn[k]), "zeta": float(zeta[k])} for k in range(m) if k not in keep]
     if not keep:
-        raise FitError(f"every pole found in band={band!r} has zero or negative damping: no physical mode")
+        raise FitError(f"no physical mode in band={band!r}: every pole found has zero, negative or very high "
+                       f"damping, or lies outside the band ({dropped})")
     keep = np.array(keep)
     shapes = R[:, keep].copy()
     dp = [o for o, name in enumerate(frf.outputs) if name == frf.inputs[ii]]
@@ -355,7 +357,7 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
         if "resolution_limited" in warn:
             msg += " (half-power bandwidth spans too few lines: window leakage biases zeta upwards)"
         if dropped:
-            msg += f"; {len(dropped)} pole(s) with zero or negative damping left out"
+            msg += f"; {len(dropped)} pole(s) left out (zero, negative or over 0.5 damping, or outside the band)"
         warn_quality(f"fit_modes: {msg.strip('; ')}", stacklevel=2)
     return est
 

@@ -12,12 +12,13 @@ from .hdf5 import read_hdf5, write_hdf5
 from .lazy import LazyRecord, open_record
 from .lvm import read_lvm
 from .mat import read_mat
+from .uff import read_frf_uff, read_uff
 from .wav import read_wav, write_wav
 
-__all__ = ["read", "write", "open_record", "LazyRecord", "FORMATS"]
+__all__ = ["read", "write", "open_record", "LazyRecord", "FORMATS", "read_frf", "read_spectrum"]
 
 _READERS = {".csv": read_csv, ".txt": read_csv, ".tsv": read_csv, ".h5": read_hdf5, ".hdf5": read_hdf5,
-            ".wav": read_wav, ".mat": read_mat, ".lvm": read_lvm}
+            ".wav": read_wav, ".mat": read_mat, ".lvm": read_lvm, ".uff": read_uff, ".unv": read_uff}
 _WRITERS = {".csv": write_csv, ".h5": write_hdf5, ".hdf5": write_hdf5, ".wav": write_wav}
 FORMATS = tuple(sorted(_READERS))
 
@@ -60,3 +61,42 @@ def write(path: str | os.PathLike, obj) -> Path:
         raise ParameterError(f"path={str(path)!r}: cannot write {ext!r}; writable: {tuple(sorted(_WRITERS))}")
     _WRITERS[ext](p, obj)
     return p
+
+
+def read_frf(path: str | os.PathLike, *, variable: str | None = None, fs: float | None = None):
+    """Read frequency response functions: UFF dataset 58 function type 4 (.uff/.unv), or a MATLAB
+    variable holding a complex FRF with its frequency vector (``variable``, e.g. "Hf_chan_2";
+    the frequency axis from a "Freq_domain"-like vector or from ``fs`` and the line count)."""
+    from ..core.results import FRF
+    p = Path(path)
+    if not p.exists():
+        raise ParameterError(f"path={str(path)!r} does not exist")
+    ext = p.suffix.lower()
+    if ext in (".uff", ".unv"):
+        return read_frf_uff(p)
+    if ext == ".mat":
+        import numpy as np
+        from .mat import _leaves_v5
+        leaves = _leaves_v5(p)
+        if variable is None:
+            cands = [k for k, v in leaves.items() if np.iscomplexobj(v) and v.size > 8]
+            if len(cands) != 1:
+                raise ParameterError(f"variable= is required: complex variables in {str(path)!r}: {cands}")
+            variable = cands[0]
+        if variable not in leaves:
+            raise ParameterError(f"variable={variable!r} is not in {str(path)!r}")
+        h = np.asarray(leaves[variable]).ravel()
+        fvec = next((np.asarray(v, float).ravel() for k, v in leaves.items()
+                     if "freq" in k.lower() and np.size(v) == h.size), None)
+        if fvec is None:
+            raise ParameterError(f"no frequency vector of {h.size} lines in {str(path)!r}")
+        return FRF(fvec, h, "unknown", estimator="file", outputs=(variable,), inputs=("force",),
+                   params={"source": str(p)})
+    raise ParameterError(f"path={str(path)!r}: FRFs are read from .uff/.unv or .mat, not {ext!r}")
+
+
+def read_spectrum(path: str | os.PathLike):
+    """Read a spectrum stored as text by LabVIEW (.lvm, X column in Hz); dB values (re 1 unit)
+    become linear amplitudes. Returns a vm.Spectrum of kind "amplitude"."""
+    from .lvm import read_lvm_spectrum
+    return read_lvm_spectrum(path)

@@ -101,3 +101,44 @@ def read_lvm(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
     pick = select_names(names, channels, source=src)
     return make_record(values[:, pick].T, fs, [names[i] for i in pick], quantity=quantity, unit=unit,
                        units=[file_unit] * len(pick), t0=t0, meta={"source": str(path)}, source=src)
+
+
+def read_lvm_spectrum(path):
+    """A LabVIEW FFT export: frequency in the X column, magnitude (dB re 1 unit when the channel says
+    so, else linear); returns an amplitude Spectrum."""
+    import re as _re
+    from ..core.results import Spectrum
+    src = f"LVM file {str(path)!r}"
+    text = Path(path).read_text(encoding="latin-1")
+    lines = text.splitlines()
+    ends = [i for i, ln in enumerate(lines) if ln.strip().startswith(_END)]
+    if len(ends) < 2:
+        raise ParameterError(f"{src}: no LabVIEW header with a channel block: not a spectrum export")
+    head = {}
+    for ln in lines[:ends[1]]:
+        parts = ln.split("\t")
+        if parts and parts[0].strip():
+            head[parts[0].strip()] = [p.strip() for p in parts[1:] if p.strip()]
+    body = ends[1] + 1
+    while body < len(lines) and not lines[body].strip():
+        body += 1
+    names = lines[body].split("\t") if lines[body].startswith("X_Value") else []
+    rows = [ln.split("\t") for ln in lines[body + (1 if names else 0):] if ln.strip()]
+    try:
+        arr = np.array([[float(v) for v in r[:2]] for r in rows])
+    except (ValueError, IndexError):
+        raise ParameterError(f"{src}: spectrum rows are not numbers (truncated file?)") from None
+    freq, val = arr[:, 0], arr[:, 1]
+    label = names[1].strip() if len(names) > 1 else "ch0"
+    unit_lab = (head.get("Y_Unit_Label") or [""])[0]
+    is_db = "dB" in label or (val < 0).any()
+    amp = 10 ** (val / 20) if is_db else val
+    try:
+        unit = _units.normalize_unit(unit_lab)
+    except UnitError:
+        unit = ""
+    scaling = "rms" if _re.search(r"RMS", label, _re.I) else "peak"
+    q = _units.quantity_of(unit) if unit else "unknown"
+    df = float(np.median(np.diff(freq)))
+    return Spectrum(freq, amp, "amplitude", unit, (label,), q,
+                    {"scaling": scaling, "source": str(path), "from_db": is_db, "fs": 2 * freq[-1] + df})
