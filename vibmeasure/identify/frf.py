@@ -74,8 +74,11 @@ def _h_from_sums(Gxx, Gyx, Gyy, estimator, n_in):
         if estimator == "H2":
             H = (Gyy / gyx.conj())[:, None]
         else:  # Hv: total least squares, equal noise on input and output
-            d = Gyy - gxx
-            H = ((d + np.sqrt(d ** 2 + 4 * np.abs(gyx) ** 2)) / (2 * gyx.conj()))[:, None]
+            d = Gyy - gxx.real
+            root = np.sqrt(d ** 2 + 4 * np.abs(gyx) ** 2)
+            # (d + root) / (2 conj(Gyx)), written without cancellation for d < 0: 2 Gyx / (root - d)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                H = np.where(d >= 0, (d + root) / (2 * gyx.conj()), 2 * gyx / (root - d))[:, None]
     with np.errstate(invalid="ignore", divide="ignore"):
         if n_in == 1:
             coh = np.abs(Gyx[:, 0]) ** 2 / (Gxx[0, 0].real * Gyy)

@@ -214,6 +214,8 @@ def _residual_search(w, H, theta, coef, r, sw, n_modes, max_add=4):
         e = e / s2
         win = 5
         ms = np.convolve(e, np.ones(win), mode="same")
+        edge = max(win, int(0.03 * nf))  # the band's ends belong to the residual terms, not to new modes
+        ms[:edge] = ms[-edge:] = 0.0
         k = int(np.argmax(ms))
         expect = n_out * win
         if n_modes is None and ms[k] < expect + 5 * np.sqrt(expect):
