@@ -60,7 +60,8 @@ def _h_from_sums(Gxx, Gyx, Gyy, estimator, n_in):
     n_out, nf = Gyy.shape
     if estimator == "H1":
         if n_in == 1:
-            H = (Gyx[:, 0] / Gxx[0, 0])[:, None]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                H = (Gyx[:, 0] / Gxx[0, 0])[:, None]
         else:
             H = np.einsum("oif->fio", Gyx)  # (nf, n_in, n_out) for the solve
             Gxx_f = np.transpose(Gxx, (2, 1, 0))  # (nf, j, i): solve X^T
@@ -88,6 +89,13 @@ def _h_from_sums(Gxx, Gyx, Gyy, estimator, n_in):
             sol = np.linalg.solve(Gxx_f, np.conj(np.transpose(g, (0, 2, 1))))  # Gxx^-1 Gxy
             coh = np.real(np.einsum("foi,fio->fo", g, sol)).T / Gyy
     coh = np.clip(np.where(np.isfinite(coh), coh.real, 0.0), 0.0, 1.0)
+    # lines the input did not excite carry no information: NaN, not a number made of noise
+    power_in = np.real(np.einsum("iif->f", Gxx))
+    dead = power_in <= 1e-12 * power_in.max()
+    if dead.any():
+        H = H.copy()
+        H[..., dead] = np.nan
+        coh[:, dead] = 0.0
     return H, coh
 
 

@@ -29,7 +29,12 @@ def _band_lines(frf: FRF, band, inp):
         raise ParameterError(f"frf must be a vm.FRF, got {type(frf).__name__}")
     if band is None:
         raise ParameterError("band=(lo, hi) in Hz is required: the frequency range to fit")
-    lo, hi = check_band(band, 2 * frf.freq[-1] + 1e-9)
+    try:
+        lo, hi = (float(b) for b in band)
+    except (TypeError, ValueError):
+        raise ParameterError(f"band={band!r} must be a pair (lo, hi) in Hz") from None
+    if not lo < hi:
+        raise ParameterError(f"band={band!r} must have lo < hi")
     if hi > frf.freq[-1] + 1e-9 or lo < frf.freq[0] - 1e-9:
         raise ParameterError(f"band={band!r} lies outside the FRF's {frf.freq[0]:g}..{frf.freq[-1]:g} Hz")
     ii = frf.inputs.index(inp) if isinstance(inp, str) else int(inp)
@@ -78,8 +83,11 @@ def _lscf_poles(f, H, max_order):
             a = np.r_[-np.linalg.solve(M[:order, :order], M[:order, order]), 1.0]
         except np.linalg.LinAlgError:
             continue
+        if not np.isfinite(a).all():
+            continue
         z = np.roots(a[::-1])
-        z = z[np.abs(z) > 0]
+        z = z.astype(complex)
+        z = z[np.isfinite(z) & (np.abs(z) > 0)]
         lam = -np.log(z) / dt
         lam = lam[(lam.imag > 0) & (lam.real < 0)]
         fp = np.abs(lam) / (2 * np.pi)
@@ -181,18 +189,55 @@ def _full_jacobian(w, theta, coef, sw):
     return J
 
 
+def _varpro_jac(theta, w, Hw):
+    """Kaufman's variable-projection Jacobian: -P_perp (dA/dtheta) c for each output, stacked."""
+    lam = _lam(theta)
+    A = _real(_basis(w, lam))
+    Q, _ = np.linalg.qr(A)
+    Y = np.vstack([Hw.real.T, Hw.imag.T])
+    coef, *_ = np.linalg.lstsq(A, Y, rcond=None)
+    iw = 1j * w
+    n_out = Y.shape[1]
+    cols = []
+    for r, l in enumerate(lam):
+        da = 1 / (iw - l) ** 2
+        db = 1 / (iw - np.conj(l)) ** 2
+        for d_a, d_b in ((-da, -db), (1j * da, -1j * db)):   # d/d sigma, d/d wd
+            dC1, dC2 = d_a + d_b, 1j * (d_a - d_b)
+            v = _real(np.column_stack([dC1, dC2])) @ coef[2 * r:2 * r + 2]  # (2 nf, n_out)
+            v = v - Q @ (Q.T @ v)
+            cols.append(-v.ravel(order="F"))
+    return np.column_stack(cols)
+
+
 def _polish(w, H, lam0, sw):
+    """Poles by variable projection (residues and residual terms solved linearly inside), with the
+    decay rate as exp(q) so it stays positive; Levenberg-Marquardt (MINPACK) on Kaufman's Jacobian."""
     from scipy.optimize import least_squares
-    theta0 = np.column_stack([-lam0.real, lam0.imag]).ravel()
     Hw = H * sw[:, None]
-    fun = lambda th: _varpro(th, w, Hw)[0]  # noqa: E731
-    lb = np.tile([1e-9, w[0] * 0.5], lam0.size)
-    ub = np.tile([np.inf, w[-1] * 1.5], lam0.size)
-    theta0 = np.clip(theta0, lb + 1e-12, ub)
-    sol = least_squares(fun, theta0, bounds=(lb, ub), x_scale=np.abs(theta0) + 1e-9, xtol=1e-12, ftol=1e-12,
-                        gtol=1e-12, method="trf")
-    r, coef = _varpro(sol.x, w, Hw)
-    return sol.x, coef, r
+    sig0 = np.maximum(-lam0.real, 1e-6 * np.abs(lam0.imag))
+    q0 = np.column_stack([np.log(sig0), lam0.imag]).ravel()
+
+    q_hi = np.log(10 * w[-1])
+
+    def theta_of(q):
+        th = q.copy()
+        th[0::2] = np.exp(np.clip(q[0::2], -40.0, q_hi))  # a decay rate between ~0 and 10 w_max
+        th[1::2] = np.clip(q[1::2], 1e-3 * w[0], 10 * w[-1])
+        return th
+
+    def jac(q):
+        th = theta_of(q)
+        J = _varpro_jac(th, w, Hw)
+        J[:, 0::2] *= th[0::2]  # d/dq = sigma d/dsigma
+        return J
+    fun = lambda q: _varpro(theta_of(q), w, Hw)[0]  # noqa: E731
+    scale = np.column_stack([np.ones(lam0.size), np.maximum(sig0, w[1] - w[0])]).ravel()
+    sol = least_squares(fun, q0, jac=jac, x_scale=scale, xtol=1e-10, ftol=1e-10, gtol=1e-10, method="lm",
+                        max_nfev=50 * (q0.size + 1))
+    theta = theta_of(sol.x)
+    r, coef = _varpro(theta, w, Hw)
+    return theta, coef, r
 
 
 DETECT_FRF = 30.0  # a mode found in the residual must lower the weighted residual sum of squares this much
@@ -204,9 +249,12 @@ def _residual_search(w, H, theta, coef, r, sw, n_modes, max_add=4):
     there and keep it if the fit improves by more than DETECT_FRF (or while n_modes asks for more)."""
     n_out, nf = H.shape
     added = 0
+    signal = float(np.sum(np.abs(H * sw[:, None]) ** 2))
     for _ in range(max_add):
         m = theta.size // 2
         if n_modes is not None and m >= n_modes:
+            break
+        if float(r @ r) < 1e-16 * signal:  # the fit is exact to round-off: nothing is missing
             break
         res = r.reshape(n_out, 2, nf)
         e = np.sum(res[:, 0] ** 2 + res[:, 1] ** 2, axis=0)  # per line, about 2 n_out / 2 = n_out on average
@@ -313,7 +361,7 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
         fl = []
         if not (np.isfinite(zeta[k]) and 0 < zeta[k] < 0.5 and band[0] <= fn[k] <= band[1]):
             continue  # no/negative damping, over-damped or outside the band: reported in extras, never returned
-        lines = 2 * zeta[k] * fn[k] / df
+        lines = 2 * theta[2 * k] / (2 * np.pi) / df  # the measured bandwidth (before any window correction)
         if frf.estimator != "analytic" and lines < (MIN_LINES_WINDOWED if windowed else 3):
             fl.append("resolution_limited")
         if frf.coherence is not None:
