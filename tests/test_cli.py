@@ -147,3 +147,56 @@ def test_spectrum_errors_and_progress(sample_dir, monkeypatch, tmp_path):
     monkeypatch.setattr(cli._Progress.__init__, "__defaults__", (0.0,))  # show at once
     code, _, err = run(["spectrum", str(sample_dir / "machine.h5"), "--kind", "psd", "--nperseg", "256"])
     assert code == 0 and "psd [" in err and "100%" in err
+
+
+# --- frf and modes ----------------------------------------------------------------------------
+def _hammer_csv(tmp_path):
+    from tests.test_frf import impact_record
+    rec = impact_record()
+    return vm.write(tmp_path / "hammer.csv", rec)
+
+
+def test_frf_and_modes_from_hammer_csv(tmp_path):
+    p = _hammer_csv(tmp_path)
+    png = tmp_path / "bode.png"
+    code, out, err = run(["frf", str(p), "--input", "hammer", "--impact", "--json", "--plot", str(png)])
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["outputs"] == ["a0", "a1", "a2"] and doc["n_averages"] == 3 and doc["form"] == "receptance"
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    stab = tmp_path / "stab.png"
+    code, out, err = run(["modes", str(p), "--input", "hammer", "--impact", "--band", "5", "150", "--json",
+                          "--plot", str(stab)])
+    assert code == 0, err
+    modes = json.loads(out)["modes"]
+    np.testing.assert_allclose([m["fn_hz"] for m in modes], [21.3, 57.9, 110.4], rtol=5e-4)
+    np.testing.assert_allclose([m["zeta"] for m in modes], [0.010, 0.020, 0.015], rtol=0.01)
+    assert stab.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_modes_from_uff_frf_file(tmp_path):
+    pyuff = pytest.importorskip("pyuff")
+    freq = np.arange(0, 150.25, 0.25)
+    frf = vm.synth.modal_frf(freq, fn=[21.3, 57.9], zeta=[0.01, 0.02], shapes=[[0.5, 0.6], [0.7, -0.2]])
+    path = tmp_path / "frf.uff"
+    u = pyuff.UFF(str(path))
+    for o in range(2):
+        d = pyuff.prepare_58(func_type=4, rsp_node=o + 1, rsp_dir=3, ref_node=1, ref_dir=3, data=frf.h[o, 0],
+                             x=freq, id1=f"frf {o}", rsp_ent_name=f"node{o + 1}", ref_ent_name="node1",
+                             abscissa_spacing=1, abscissa_spec_data_type=18, ordinate_spec_data_type=8,
+                             orddenom_spec_data_type=13, binary=0)
+        u.write_sets(d, mode="add" if o else "overwrite")
+    back = vm.read_frf(path)
+    assert back.outputs == ("node1", "node2") and back.form == "receptance"
+    np.testing.assert_allclose(back.h, frf.h, rtol=1e-5)  # ASCII UFF keeps ~6-7 digits
+    code, out, err = run(["modes", str(path), "--band", "5", "100", "--json"])
+    assert code == 0, err
+    np.testing.assert_allclose([m["fn_hz"] for m in json.loads(out)["modes"]], [21.3, 57.9], rtol=1e-5)
+
+
+def test_modes_errors(tmp_path):
+    p = _hammer_csv(tmp_path)
+    code, _, err = run(["modes", str(p), "--input", "nobody", "--band", "5", "150"])
+    assert code == 2 and "'nobody' is not in the file" in err
+    code, _, err = run(["modes", str(p), "--input", "hammer", "--impact", "--band", "200", "300"])
+    assert code == 2 and "band=" in err
