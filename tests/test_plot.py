@@ -33,3 +33,20 @@ def test_plot_rejects_wrong_objects():
     rec = vm.synth.free_decay(fn=10.0, zeta=0.02, fs=1000.0, duration=2.0)
     with pytest.raises(vm.ParameterError, match="est must be"):
         plot_ringdown(rec, "estimate")
+
+
+def test_frf_plots_draw(tmp_path):
+    import matplotlib.pyplot as plt
+    from vibmeasure.plot import plot_frf, plot_mac, plot_nyquist, plot_stabilisation
+    fr = vm.synth.modal_frf(np.arange(0, 150.25, 0.25), fn=[21.3, 57.9], zeta=[0.01, 0.02],
+                            shapes=[[0.5, 0.6], [0.7, -0.2]])
+    est = vm.fit_modes(fr, band=(1, 150))
+    am, ap, ac = plot_frf(fr, est=est)
+    assert len(am.get_lines()) >= 2  # measured and synthesised
+    assert plot_nyquist(fr, band=(18, 25)).get_lines()
+    ax = plot_stabilisation(est, frf=fr)
+    assert any(l.get_label() == "stable f" for l in ax.get_lines())
+    assert plot_mac(vm.mac(est.shapes), labels=["1", "2"]).images
+    plt.close("all")
+    with pytest.raises(vm.ParameterError, match="vm.fit_modes"):
+        plot_stabilisation(vm.ringdown(vm.synth.free_decay(fn=10.0, zeta=0.02, fs=1000.0, duration=2.0)))
