@@ -402,13 +402,11 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
     est = ModalEstimate(fn=fn[keep], zeta=zeta[keep], fn_std=fn_std[keep], zeta_std=zeta_std[keep],
                         method="fit_modes", mode_flags=tuple(flags_mode), shapes=shapes, extras=extras)
     warn = [fl for fl in est.flags if fl in ("resolution_limited", "low_coherence")]
-    if warn or dropped:
+    if warn:  # poles left out are not modes: they are listed in extras["dropped_poles"], no warning
         msg = ", ".join(warn)
         if "resolution_limited" in warn:
             msg += " (half-power bandwidth spans too few lines: window leakage biases zeta upwards)"
-        if dropped:
-            msg += f"; {len(dropped)} pole(s) left out (zero, negative or over 0.5 damping, or outside the band)"
-        warn_quality(f"fit_modes: {msg.strip('; ')}", stacklevel=2)
+        warn_quality(f"fit_modes: {msg}", stacklevel=2)
     return est
 
 
