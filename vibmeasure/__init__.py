@@ -5,7 +5,7 @@
 >>> est = vm.ringdown(rec)          # ModalEstimate: fn, zeta, fn_std, zeta_std, flags
 """
 
-from . import synth
+from . import models, synth
 from .core import units
 from .core.errors import FitError, ParameterError, QualityWarning, UnitError, VibMeasureError
 from .core.record import Channel, Record
@@ -14,6 +14,7 @@ from .identify.damping import half_power, hilbert_decay, log_decrement, zeta_fro
 from .identify.frf import estimate_frf, find_hits, impact_frf
 from .identify.modal import circle_fit, fit_modes, mac, modal_crb, synthesize_frf
 from .identify.ringdown import ringdown, ringdown_crb
+from .monitor.compare import Comparison, History, compare
 from .io import LazyRecord, read, read_frf, read_spectrum, write
 from .io import open_record as open  # noqa: A001  (vm.open: the documented name)
 from .signal.demod import envelope, envelope_spectrum
@@ -33,5 +34,5 @@ __all__ = [
     "detrend", "filter", "decimate", "resample", "integrate", "differentiate",
     "ringdown", "ringdown_crb", "estimate_frf", "impact_frf", "find_hits", "fit_modes", "circle_fit", "mac",
     "modal_crb", "synthesize_frf", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
-    "synth", "units", "__version__",
+    "compare", "Comparison", "History", "models", "synth", "units", "__version__",
 ]

@@ -85,7 +85,114 @@ def _parser() -> argparse.ArgumentParser:
         q.add_argument("--json", action="store_true", help="print one JSON document")
         q.add_argument("--plot", metavar="OUT.png", help="write a picture (Bode + coherence, or the "
                                                          "stabilisation diagram for modes)")
+
+    md = sub.add_parser("model", help="predictions of a model described in a TOML file",
+                        description="Natural frequencies and damping a model predicts (vm.models.load).")
+    md.add_argument("file", help="model.toml")
+    md.add_argument("--modes", type=int, default=3, help="modes of a continuum (default 3)")
+    md.add_argument("--json", action="store_true", help="print one JSON document")
+
+    cp = sub.add_parser("compare", help="identify a measurement and compare it with a model or a baseline",
+                        description="Identify the record (ring-down by default; FRF + fit_modes with --input) "
+                                    "and compare with a model (--model) or a healthy baseline history (--baseline).")
+    cp.add_argument("file", help="measurement record")
+    ref = cp.add_mutually_exclusive_group(required=True)
+    ref.add_argument("--model", help="model.toml")
+    ref.add_argument("--baseline", help="baseline history (.h5 written by vm.History.save)")
+    cp.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
+    cp.add_argument("--channel", help="response channel for a ring-down")
+    cp.add_argument("--input", help="force channel: identify from FRFs with fit_modes instead of a ring-down")
+    cp.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"), help="band for fit_modes / ringdown")
+    cp.add_argument("--modes", type=int, default=3, help="modes of a continuum model (default 3)")
+    cp.add_argument("--rtol-fn", type=float, default=0.02, help="frequency tolerance for an alarm (default 0.02)")
+    cp.add_argument("--json", action="store_true", help="print one JSON document")
+    cp.add_argument("--plot", metavar="OUT.png", help="picture of measured versus predicted")
     return p
+
+
+def _predict(model, n):
+    from .models.continua import Beam, Rod, String
+    return model.modes(n) if isinstance(model, (Beam, Rod, String)) else model.modes()
+
+
+def _main_model(args, out, err) -> int:
+    from .models import load
+    try:
+        model = load(args.file)
+        est = _predict(model, args.modes)
+    except (VibMeasureError, OSError) as exc:
+        print(f"vibmeasure: error: {exc}", file=err)
+        return 2
+    if args.json:
+        d = est.to_dict()
+        json.dump({"command": "model", "file": str(args.file), "model": repr(model), "modes": d["modes"]}, out,
+                  indent=2, allow_nan=False)
+        out.write("\n")
+    else:
+        print(f"{args.file}: {model!r}", file=out)
+        for i in range(est.n_modes):
+            print(f"  mode {i + 1}: fn {est.fn[i]:.6g} Hz  zeta {est.zeta[i]:.5g}", file=out)
+    return 0
+
+
+def _main_compare(args, out, err) -> int:
+    from . import io
+    from .identify import ringdown as rd
+    from .models import load
+    from .monitor.compare import History, compare
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", QualityWarning)
+        try:
+            ref = History.load(args.baseline) if args.baseline else load(args.model)
+            pred = ref if isinstance(ref, History) else _predict(ref, args.modes)
+            band = tuple(args.band) if args.band else None
+            if args.input:
+                args.file, args.variable, args.impact, args.output = args.file, None, False, None
+                args.estimator, args.window, args.nperseg = "H1", "hann", None
+                frf = _get_frf(args)
+                from .identify.modal import fit_modes
+                if band is None:
+                    raise VibMeasureError("--band LO HI is required with --input (the fit_modes band)")
+                est = fit_modes(frf, band=band)
+            else:
+                rec = io.read(args.file, fs=args.fs)
+                est = rd.ringdown(rec, channel=args.channel, band=band)
+            cmp = compare(est, pred, rtol_fn=args.rtol_fn)
+            if args.plot:
+                import matplotlib
+                matplotlib.use("Agg")
+                import matplotlib.pyplot as plt
+                fig, ax = plt.subplots(figsize=(7, 4))
+                colors = {"ok": "C2", "watch": "C1", "alarm": "C3"}
+                for r in cmp.rows:
+                    ax.bar(f"{r['fn_predicted_hz']:.4g} Hz", r["fn_dev_pct"], color=colors[r["verdict"]])
+                ax.axhline(0, color="k", lw=0.6)
+                for sgn in (-1, 1):
+                    ax.axhline(sgn * args.rtol_fn * 100, color="C3", ls="--", lw=0.8)
+                ax.set_ylabel("fn deviation [%]")
+                ax.set_title(f"measured vs {'baseline' if args.baseline else 'model'}: {cmp.verdict}", fontsize=9)
+                try:
+                    _atomic_savefig(fig, args.plot)
+                finally:
+                    plt.close(fig)
+        except (VibMeasureError, OSError) as exc:
+            print(f"vibmeasure: error: {exc}", file=err)
+            return 2
+    msgs = [str(w.message) for w in caught if issubclass(w.category, QualityWarning)]
+    if args.json:
+        doc = {"command": "compare", "file": str(args.file), **cmp.to_dict(), "measured": est.to_dict()["modes"],
+               "warnings": msgs}
+        json.dump(doc, out, indent=2, allow_nan=False)
+        out.write("\n")
+    else:
+        print(f"{args.file}: verdict {cmp.verdict.upper()} - {cmp.reason}", file=out)
+        for r in cmp.rows:
+            print(f"  {r['fn_predicted_hz']:10.5g} Hz predicted  {r['fn_measured_hz']:10.5g} Hz measured  "
+                  f"{r['fn_dev_pct']:+7.2f} %  dk/k {r['implied_stiffness_change_pct']:+7.2f} %  {r['verdict']}",
+                  file=out)
+    for m in msgs:
+        print(f"vibmeasure: warning: {m}", file=err)
+    return 0
 
 
 def _get_frf(args):
@@ -336,6 +443,10 @@ def main(argv=None, *, out=None, err=None) -> int:
         return _main_spectrum(args, out, err)
     if args.command in ("frf", "modes"):
         return _main_frf(args, out, err)
+    if args.command == "model":
+        return _main_model(args, out, err)
+    if args.command == "compare":
+        return _main_compare(args, out, err)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", QualityWarning)
         try:

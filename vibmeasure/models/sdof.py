@@ -1,0 +1,211 @@
+"""Single-degree-of-freedom model: what a test on a mass-spring-damper should measure.
+
+x'' m + c x' + k x = F(t) (viscous) or k (1 + i eta) for structural (hysteretic) damping in
+harmonic response; Coulomb (dry friction) free response by its closed form.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core._validate import positive
+from ..core.errors import ParameterError
+from ..core.results import ModalEstimate
+
+__all__ = ["SDOF"]
+
+_FORMS = {"receptance": 0, "mobility": 1, "accelerance": 2}
+
+
+class SDOF:
+    """A mass-spring-damper: m (kg), k (N/m) and one of c (N s/m), zeta, or loss_factor (eta).
+
+    Properties: wn (rad/s), fn, fd (Hz), c_crit, zeta, c, Td, log_decrement, Q.
+    """
+
+    def __init__(self, *, m: float = 1.0, k: float, c: float | None = None, zeta: float | None = None,
+                 loss_factor: float | None = None):
+        self.m = positive(m, "m")
+        self.k = positive(k, "k")
+        given = [x is not None for x in (c, zeta, loss_factor)]
+        if sum(given) > 1:
+            raise ParameterError("give one of c, zeta and loss_factor, not several")
+        self.c_crit = 2 * np.sqrt(self.k * self.m)
+        self.loss_factor = 0.0 if loss_factor is None else positive(loss_factor, "loss_factor", allow_zero=True)
+        if zeta is not None:
+            self.zeta = positive(zeta, "zeta", allow_zero=True)
+            self.c = self.zeta * self.c_crit
+        else:
+            self.c = 0.0 if c is None else positive(c, "c", allow_zero=True)
+            self.zeta = self.c / self.c_crit
+
+    # --- natural properties --------------------------------------------------------------------
+    @property
+    def wn(self) -> float:
+        return float(np.sqrt(self.k / self.m))
+
+    @property
+    def fn(self) -> float:
+        return self.wn / (2 * np.pi)
+
+    def _need_under(self, what):
+        if self.zeta >= 1:
+            raise ParameterError(f"{what}: zeta={self.zeta:.4g} >= 1 (critically or over damped): the system does "
+                                 "not oscillate")
+
+    @property
+    def wd(self) -> float:
+        self._need_under("wd")
+        return self.wn * np.sqrt(1 - self.zeta ** 2)
+
+    @property
+    def fd(self) -> float:
+        return self.wd / (2 * np.pi)
+
+    @property
+    def Td(self) -> float:
+        """Damped period, s."""
+        return 1 / self.fd
+
+    @property
+    def log_decrement(self) -> float:
+        self._need_under("log_decrement")
+        return 2 * np.pi * self.zeta / np.sqrt(1 - self.zeta ** 2)
+
+    @property
+    def Q(self) -> float:
+        return np.inf if self.zeta == 0 else 1 / (2 * self.zeta)
+
+    @property
+    def regime(self) -> str:
+        return "undamped" if self.zeta == 0 else "underdamped" if self.zeta < 1 else \
+            "critically damped" if np.isclose(self.zeta, 1.0, rtol=1e-9) else "overdamped"
+
+    def modes(self) -> ModalEstimate:
+        """The prediction as a ModalEstimate (so vm.compare works the same for every model)."""
+        z = self.zeta if self.loss_factor == 0 else self.loss_factor / 2
+        return ModalEstimate(fn=[self.fn], zeta=[z], fn_std=[0.0], zeta_std=[0.0], method="model:sdof",
+                             extras={"m": self.m, "k": self.k, "c": self.c, "loss_factor": self.loss_factor})
+
+    # --- free response -------------------------------------------------------------------------
+    def free_response(self, t, *, x0: float = 0.0, v0: float = 0.0) -> np.ndarray:
+        """Displacement from x0, v0 for the under-, critically and over-damped cases (closed forms)."""
+        t = np.asarray(t, float)
+        wn, z = self.wn, self.zeta
+        if z < 1 and not np.isclose(z, 1.0, rtol=1e-9):
+            wd = wn * np.sqrt(1 - z ** 2)
+            return np.exp(-z * wn * t) * (x0 * np.cos(wd * t) + (v0 + z * wn * x0) / wd * np.sin(wd * t))
+        if np.isclose(z, 1.0, rtol=1e-9):
+            return np.exp(-wn * t) * (x0 + (v0 + wn * x0) * t)
+        r = wn * np.sqrt(z ** 2 - 1)
+        s1, s2 = -z * wn + r, -z * wn - r
+        c1 = (v0 - s2 * x0) / (s1 - s2)
+        c2 = (s1 * x0 - v0) / (s1 - s2)
+        return c1 * np.exp(s1 * t) + c2 * np.exp(s2 * t)
+
+    def time_to_decay(self, ratio: float) -> float:
+        """Time for the envelope exp(-zeta wn t) to fall to ``ratio`` of its start (e.g. 1/50)."""
+        if not 0 < ratio < 1:
+            raise ParameterError(f"ratio={ratio} must be between 0 and 1")
+        if self.zeta == 0:
+            return np.inf
+        return float(-np.log(ratio) / (self.zeta * self.wn))
+
+    def settling_time(self, fraction: float = 0.02) -> float:
+        """Time until the free or step response stays within ``fraction`` (envelope criterion)."""
+        return self.time_to_decay(fraction)
+
+    def coulomb_free_response(self, t, *, x0: float, friction_force: float) -> np.ndarray:
+        """Dry friction F instead of viscous damping, released from rest at x0: the amplitude falls
+        by 4 F / k per cycle at wn and stops once it is below F / k."""
+        from ..synth import coulomb_response
+        f = positive(friction_force, "friction_force")
+        return coulomb_response(t, fn=self.fn, friction_decay=4 * f / self.k, amplitude=x0)
+
+    # --- harmonic response -----------------------------------------------------------------------
+    def frf(self, freq, *, form: str = "receptance") -> np.ndarray:
+        """H(f) = 1 / (k - m w^2 + i w c) (receptance; hysteretic: k (1 + i eta)), times (i w)^n."""
+        if form not in _FORMS:
+            raise ParameterError(f"form={form!r} must be one of {tuple(_FORMS)}")
+        w = 2 * np.pi * np.asarray(freq, float)
+        h = 1 / (self.k * (1 + 1j * self.loss_factor) - self.m * w ** 2 + 1j * w * self.c)
+        return h * (1j * w) ** _FORMS[form]
+
+    def magnification(self, freq) -> tuple[np.ndarray, np.ndarray]:
+        """Dynamic magnification |X k / F0| and phase lag (rad) of the steady response to a force."""
+        h = self.frf(freq) * self.k
+        return np.abs(h), -np.angle(h)
+
+    def harmonic_response(self, freq, F0: float) -> tuple[np.ndarray, np.ndarray]:
+        """Steady displacement amplitude and phase lag under F0 sin(w t)."""
+        mag, ph = self.magnification(freq)
+        return mag * F0 / self.k, ph
+
+    def transmissibility(self, freq) -> np.ndarray:
+        """Force (to the foundation) and displacement (from a moving base) transmissibility:
+        sqrt(1 + (2 zeta r)^2) / sqrt((1 - r^2)^2 + (2 zeta r)^2) - the same for viscous damping."""
+        w = 2 * np.pi * np.asarray(freq, float)
+        num = self.k * (1 + 1j * self.loss_factor) + 1j * w * self.c
+        return np.abs(num / (self.k * (1 + 1j * self.loss_factor) - self.m * w ** 2 + 1j * w * self.c))
+
+    def base_excitation(self, freq, Y: float) -> dict:
+        """Base moving as Y sin(w t): absolute amplitude X = Y T and relative amplitude Z."""
+        w = 2 * np.pi * np.asarray(freq, float)
+        T = self.transmissibility(freq)
+        rel = np.abs(self.m * w ** 2 * self.frf(freq)) * Y
+        return {"absolute": T * Y, "relative": rel}
+
+    def unbalance_response(self, freq, *, me: float) -> np.ndarray:
+        """Amplitude from a rotating unbalance me (kg m) at rotation frequency f: me w^2 |H|."""
+        w = 2 * np.pi * np.asarray(freq, float)
+        return positive(me, "me") * w ** 2 * np.abs(self.frf(freq))
+
+    # --- transient response ------------------------------------------------------------------
+    def impulse_response(self, t) -> np.ndarray:
+        """Displacement per unit impulse (N s): the free response from v0 = 1/m."""
+        return self.free_response(t, x0=0.0, v0=1.0 / self.m)
+
+    def step_response(self, t, F0: float = 1.0) -> np.ndarray:
+        """Displacement under a force F0 switched on at t = 0 (from rest)."""
+        return F0 / self.k * (1 - self.free_response(t, x0=1.0, v0=0.0))
+
+    def ramp_response(self, t, rate: float = 1.0) -> np.ndarray:
+        """Displacement under F = rate t from rest: the integral of the step response."""
+        t = np.asarray(t, float)
+        # x = (rate/k) (t - 2 zeta/wn) + rate/k * free response from x0 = 2 zeta/wn, v0 = -1
+        return rate / self.k * (t - 2 * self.zeta / self.wn + self.free_response(t, x0=2 * self.zeta / self.wn,
+                                                                               v0=-1.0))
+
+    def response(self, t, force) -> np.ndarray:
+        """Displacement under an arbitrary force sampled at times t (from rest), by exact
+        state-space integration with the force linear between samples."""
+        from scipy.signal import lsim
+        t = np.asarray(t, float)
+        force = np.asarray(force, float)
+        if force.shape != t.shape:
+            raise ParameterError(f"force has shape {force.shape}; it must match t {t.shape}")
+        A = [[0.0, 1.0], [-self.k / self.m, -self.c / self.m]]
+        _, y, _ = lsim((A, [[0.0], [1.0 / self.m]], [[1.0, 0.0]], [[0.0]]), force, t)
+        return y
+
+    def periodic_response(self, t, *, period: float, a0: float = 0.0, a=(), b=()) -> np.ndarray:
+        """Steady response to F(t) = a0/2 + sum a_n cos(n w t) + b_n sin(n w t) (Fourier series),
+        each harmonic through the FRF."""
+        t = np.asarray(t, float)
+        w0 = 2 * np.pi / positive(period, "period")
+        x = np.full_like(t, a0 / 2 / self.k)
+        a, b = np.atleast_1d(np.asarray(a, float)), np.atleast_1d(np.asarray(b, float))
+        n_h = max(a.size, b.size)
+        a, b = np.pad(a, (0, n_h - a.size)), np.pad(b, (0, n_h - b.size))
+        for n in range(1, n_h + 1):
+            H = self.frf(n * w0 / (2 * np.pi))
+            x += np.real((a[n - 1] - 1j * b[n - 1]) * H * np.exp(1j * n * w0 * t))
+        return x
+
+    def __repr__(self) -> str:
+        return f"SDOF(m={self.m:g}, k={self.k:g}, c={self.c:g}; fn={self.fn:.5g} Hz, zeta={self.zeta:.4g})"
+
+
+def stiffness_for(fn: float, m: float) -> float:
+    """Stiffness k = m (2 pi fn)^2 that puts mass m at natural frequency fn."""
+    return positive(m, "m") * (2 * np.pi * positive(fn, "fn")) ** 2

@@ -1,0 +1,1 @@
+"""Verdicts: measured versus models and baselines, trends."""
