@@ -14,7 +14,9 @@ from .identify.damping import half_power, hilbert_decay, log_decrement, zeta_fro
 from .identify.frf import estimate_frf, find_hits, impact_frf
 from .identify.modal import circle_fit, fit_modes, mac, modal_crb, synthesize_frf
 from .identify.ringdown import ringdown, ringdown_crb
+from .models.bearing import BEARINGS, Bearing, Gear
 from .monitor.compare import Comparison, History, compare
+from .monitor.machinery import Diagnosis, diagnose, severity_zone
 from .io import LazyRecord, read, read_frf, read_spectrum, write
 from .io import open_record as open  # noqa: A001  (vm.open: the documented name)
 from .signal.demod import envelope, envelope_spectrum
@@ -34,5 +36,5 @@ __all__ = [
     "detrend", "filter", "decimate", "resample", "integrate", "differentiate",
     "ringdown", "ringdown_crb", "estimate_frf", "impact_frf", "find_hits", "fit_modes", "circle_fit", "mac",
     "modal_crb", "synthesize_frf", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
-    "compare", "Comparison", "History", "models", "synth", "units", "__version__",
+    "compare", "Comparison", "History", "diagnose", "Diagnosis", "severity_zone", "Bearing", "Gear", "BEARINGS", "models", "synth", "units", "__version__",
 ]

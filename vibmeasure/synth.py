@@ -231,3 +231,79 @@ def modal_response(force, *, fs: float, fn, zeta, shapes, input_dof: int = 0, qu
         q = lfilter(np.ravel(b), a, phi[input_dof, r] * force)
         out += np.outer(phi[:, r], q)
     return out
+
+
+_FAULTS = ("none", "unbalance", "misalignment", "looseness", "bearing_outer_race", "bearing_inner_race",
+           "bearing_ball", "gear_mesh")
+
+
+def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, duration: float = 10.0,
+            severity: float = 1.0, snr_db: float = 20.0, bearing=None, gear_teeth: int = 32,
+            resonance_hz: float = 3500.0, seed=None, unit: str = "g") -> Record:
+    """Accelerometer record of a rotating machine, healthy or with one fault, for tests and demos.
+
+    Every machine has a small residual 1X and broadband noise. Faults: unbalance (strong 1X),
+    misalignment (strong 2X beside 1X), looseness (many harmonics and 0.5X sub-harmonics), bearing
+    defects (impacts at BPFO/BPFI/BSF with 1 % slip jitter exciting a structural resonance; inner
+    race and ball faults amplitude-modulated at 1X and FTF), gear mesh (teeth x 1X with 1X
+    sidebands). ``severity`` scales the fault, ``snr_db`` is the fault signal's power over the noise.
+    The fault-free part is in g; meta holds rpm and the truth.
+    """
+    from .models.bearing import BEARINGS, Bearing
+    if fault not in _FAULTS:
+        raise ParameterError(f"fault={fault!r} must be one of {_FAULTS}")
+    fs, duration, rpm = positive(fs, "fs"), positive(duration, "duration"), positive(rpm, "rpm")
+    rng = np.random.default_rng(seed)
+    n = int(round(fs * duration))
+    t = np.arange(n) / fs
+    f1 = rpm / 60.0
+    b = bearing if isinstance(bearing, Bearing) else BEARINGS["6205-2RS"] if bearing is None else BEARINGS[bearing]
+    base = 0.02 * np.sin(2 * np.pi * f1 * t + rng.uniform(0, 2 * np.pi))  # residual unbalance, healthy level
+    sig = np.zeros(n)
+    ph = lambda: rng.uniform(0, 2 * np.pi)  # noqa: E731
+    if fault == "unbalance":
+        sig = 0.25 * np.sin(2 * np.pi * f1 * t + ph())
+    elif fault == "misalignment":
+        sig = 0.08 * np.sin(2 * np.pi * f1 * t + ph()) + 0.5 * np.sin(2 * np.pi * 2 * f1 * t + ph()) \
+            + 0.15 * np.sin(2 * np.pi * 3 * f1 * t + ph())
+    elif fault == "looseness":
+        for k, a in [(0.5, 0.08), (1, 0.1), (1.5, 0.06), (2, 0.1), (3, 0.1), (4, 0.1), (5, 0.08), (6, 0.08),
+                     (7, 0.06), (8, 0.06)]:
+            sig += a * np.sin(2 * np.pi * k * f1 * t + ph())
+    elif fault.startswith("bearing"):
+        fr = b.frequencies(f1)
+        ff = {"bearing_outer_race": fr["BPFO"], "bearing_inner_race": fr["BPFI"], "bearing_ball": fr["BSF"]}[fault]
+        period = 1.0 / ff
+        times = []
+        tk = rng.uniform(0, period)
+        while tk < duration:
+            times.append(tk)
+            tk += period * (1 + 0.01 * rng.normal())  # rolling elements slip: 1 % jitter
+        times = np.asarray(times)
+        amp = np.ones_like(times)
+        if fault == "bearing_inner_race":
+            amp = 1 + 0.8 * np.cos(2 * np.pi * f1 * times)       # the defect turns with the shaft
+        elif fault == "bearing_ball":
+            amp = 1 + 0.8 * np.cos(2 * np.pi * fr["FTF"] * times)  # the ball travels with the cage
+        wr = 2 * np.pi * resonance_hz
+        tau = 1 / (0.05 * wr)  # resonance with zeta 0.05
+        idx = np.round(times * fs).astype(int)
+        imp = np.zeros(n)
+        np.add.at(imp, idx[idx < n], amp[idx < n])
+        L = int(8 * tau * fs)
+        tt = np.arange(L) / fs
+        h = np.exp(-tt / tau) * np.sin(wr * tt)
+        sig = np.convolve(imp, h)[:n]
+        sig *= 1.0 / max(np.std(sig), 1e-300) * 0.3
+    elif fault == "gear_mesh":
+        fm = gear_teeth * f1
+        sig = 0.3 * (1 + 0.5 * np.cos(2 * np.pi * f1 * t)) * np.sin(2 * np.pi * fm * t + ph()) \
+            + 0.1 * np.sin(2 * np.pi * 2 * fm * t + ph())
+    sig = severity * sig
+    p_sig = np.mean(sig ** 2) if fault != "none" else np.mean((0.3 * np.ones(1)) ** 2) / 2
+    noise = rng.normal(0, np.sqrt(p_sig / 10 ** (snr_db / 10)), n)
+    x = base + sig + noise
+    from .core.record import Channel as _Ch
+    truth = {"kind": "machine", "fault": fault, "rpm": rpm, "severity": severity, "snr_db": snr_db}
+    return Record(x, fs, (_Ch("acc", "acceleration", unit),), meta={"rpm": rpm, "truth": truth},
+                  history=(f"synth machine {fault}",))
