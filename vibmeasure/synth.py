@@ -272,7 +272,8 @@ def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, du
             sig += a * np.sin(2 * np.pi * k * f1 * t + ph())
     elif fault.startswith("bearing"):
         fr = b.frequencies(f1)
-        ff = {"bearing_outer_race": fr["BPFO"], "bearing_inner_race": fr["BPFI"], "bearing_ball": fr["BSF"]}[fault]
+        # a ball defect strikes the inner and the outer race once per ball spin each: 2 x BSF
+        ff = {"bearing_outer_race": fr["BPFO"], "bearing_inner_race": fr["BPFI"], "bearing_ball": fr["2xBSF"]}[fault]
         period = 1.0 / ff
         times = []
         tk = rng.uniform(0, period)

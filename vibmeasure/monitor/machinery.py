@@ -184,7 +184,8 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
                 "in_scope": in_scope,
                 "note": "" if in_scope else f"{rpm:g} rpm is outside ISO 10816-3's 120-15000 rpm: zone is indicative"}
     ab = ISO_10816_3[(group, found)][0]
-    level = min(1.0, v_rms / ab) if np.isfinite(v_rms) else 1.0  # a fault must show in the vibration level
+    # shaft-order faults must matter: nothing below half the zone A/B boundary, full weight from it on
+    level = float(np.clip((v_rms - 0.5 * ab) / (0.5 * ab), 0, 1)) if np.isfinite(v_rms) else 1.0
 
     rows = []
 
@@ -271,9 +272,11 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
                 first = first or b1
             e = min(evid)
             bearing_rows.append([fault, bf[key], first, e, min(harms)])
-        ev_sorted = sorted(r[3] for r in bearing_rows)
         for fault, fk, (fo, am, db), e, h in bearing_rows:
-            second = ev_sorted[-2] if e == ev_sorted[-1] else ev_sorted[-1]
+            # the strongest other family; a ball fault's cage (FTF) modulation is its own signature
+            others = [r[3] for r in bearing_rows if r[0] != fault and not (fault == "bearing_ball"
+                                                                           and r[0] == "bearing_cage")]
+            second = max(others) if others else 0.0
             dominance = max(0.0, 1 - second / e) if e > 0 else 0.0
             conf = (1 - np.exp(-e / 2)) * dominance * (1.0 if h >= 1 else 0.4)  # harmonics make a fault
             add(fault, fk, fo, am, db, conf, f"{fault.split('_', 1)[1]} family (evidence {e:.2f}, {h} harmonic(s)) "
