@@ -107,7 +107,73 @@ def _parser() -> argparse.ArgumentParser:
     cp.add_argument("--rtol-fn", type=float, default=0.02, help="frequency tolerance for an alarm (default 0.02)")
     cp.add_argument("--json", action="store_true", help="print one JSON document")
     cp.add_argument("--plot", metavar="OUT.png", help="picture of measured versus predicted")
+
+    dg = sub.add_parser("diagnose", help="machine fault diagnosis from a vibration record",
+                        description="Fault frequencies, envelope analysis, evidence per fault family and "
+                                    "ISO 10816-3 severity.")
+    dg.add_argument("file", help="acceleration record")
+    dg.add_argument("--rpm", type=float, help="declared shaft speed (default: the file's rpm variable)")
+    g = dg.add_mutually_exclusive_group()
+    g.add_argument("--bearing", help="catalogue bearing (6205-2RS, 6203-2RS)")
+    g.add_argument("--bearing-geometry", metavar="N,d,D,angle", help="balls, ball and pitch diameter, angle (deg)")
+    dg.add_argument("--gear", type=int, metavar="TEETH", help="teeth of a gear on this shaft")
+    dg.add_argument("--group", type=int, choices=(1, 2), default=2, help="ISO 10816-3 machine group (default 2)")
+    dg.add_argument("--foundation", choices=("rigid", "flexible"), default="rigid")
+    dg.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
+    dg.add_argument("--unit", default=None, help="unit of the data when the file does not say (e.g. g)")
+    dg.add_argument("--channel", help="channel to diagnose (default: the first)")
+    dg.add_argument("--json", action="store_true", help="print one JSON document")
+    dg.add_argument("--plot", metavar="OUT.png", help="spectra with the fault lines and a severity gauge")
     return p
+
+
+def _main_diagnose(args, out, err) -> int:
+    from . import io
+    from .models.bearing import Bearing
+    from .monitor.machinery import diagnose
+    try:
+        rec = io.read(args.file, fs=args.fs, unit=args.unit, quantity="acceleration" if args.unit else None,
+                      channels=[args.channel] if args.channel else None)
+        bearing = args.bearing
+        if args.bearing_geometry:
+            try:
+                n, d, D, ang = (float(v) for v in args.bearing_geometry.split(","))
+            except ValueError:
+                raise VibMeasureError(f"--bearing-geometry {args.bearing_geometry!r} must be N,d,D,angle") from None
+            bearing = Bearing(int(n), d, D, ang)
+        diag = diagnose(rec, rpm=args.rpm, bearing=bearing, gear=args.gear, machine_group=args.group,
+                        foundation=args.foundation, channel=0)
+        if args.plot:
+            import matplotlib
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+            from .plot import plot_diagnosis
+            axes = plot_diagnosis(rec.select(0), diag)
+            try:
+                _atomic_savefig(axes[0].figure, args.plot)
+            finally:
+                plt.close(axes[0].figure)
+    except (VibMeasureError, OSError) as exc:
+        print(f"vibmeasure: error: {exc}", file=err)
+        return 2
+    if args.json:
+        json.dump({"command": "diagnose", "file": str(args.file), **diag.to_dict()}, out, indent=2, allow_nan=False)
+        out.write("\n")
+    else:
+        sev = diag.severity
+        print(f"{args.file}: {diag.top.upper()} (confidence {diag.confidence:.2f})", file=out)
+        print(f"  {diag.reason}", file=out)
+        est = diag.speed.get("estimated_rpm")
+        print(f"  speed: declared {diag.speed['declared_rpm']:g} rpm, estimated "
+              f"{'n/a' if est is None else format(est, '.1f')} rpm {diag.speed['note']}", file=out)
+        if sev.get("velocity_rms_mm_s") is not None:
+            print(f"  severity: {sev['velocity_rms_mm_s']:.2f} mm/s RMS ({sev['band_hz'][0]:g}-1000 Hz), ISO 10816-3 "
+                  f"group {sev['group']} {sev['foundation']}: zone {sev['zone']} {sev['note']}", file=out)
+        for _, r in diag.faults.iterrows():
+            print(f"  {r.fault:20s} expected {r.expected_hz:9.2f} Hz  confidence {r.confidence:.2f}", file=out)
+    if args.plot:
+        print(f"vibmeasure: wrote {args.plot}", file=err)
+    return 0
 
 
 def _predict(model, n):
@@ -445,6 +511,8 @@ def main(argv=None, *, out=None, err=None) -> int:
         return _main_frf(args, out, err)
     if args.command == "model":
         return _main_model(args, out, err)
+    if args.command == "diagnose":
+        return _main_diagnose(args, out, err)
     if args.command == "compare":
         return _main_compare(args, out, err)
     with warnings.catch_warnings(record=True) as caught:

@@ -13,7 +13,7 @@ from .core.errors import ParameterError
 from .core.record import Record
 from .core.results import ModalEstimate
 
-__all__ = ["plot_ringdown", "plot_spectrum", "plot_frf", "plot_nyquist", "plot_stabilisation", "plot_mac",
+__all__ = ["plot_ringdown", "plot_spectrum", "plot_frf", "plot_nyquist", "plot_stabilisation", "plot_mac", "plot_diagnosis",
            "decay_model"]
 
 
@@ -210,3 +210,55 @@ def plot_mac(matrix, *, labels=None, ax=None):
     ax.figure.colorbar(im, ax=ax, fraction=0.046)
     ax.set_title("MAC", fontsize=9)
     return ax
+
+
+def plot_diagnosis(rec, diag, *, axes=None):
+    """Envelope spectrum (when a bearing was given) and amplitude spectrum with the expected fault
+    lines drawn and labelled, and an ISO 10816-3 severity gauge. Returns the axes."""
+    import matplotlib.pyplot as plt
+    from .signal.demod import envelope_spectrum
+    from .signal.spectral import amplitude_spectrum
+    if axes is None:
+        fig = plt.figure(figsize=(10, 6.5))
+        gs = fig.add_gridspec(2, 4)
+        axes = (fig.add_subplot(gs[0, :3]), fig.add_subplot(gs[1, :3]), fig.add_subplot(gs[:, 3]))
+    ax_e, ax_s, ax_g = axes
+    tab = diag.faults
+    colors = {"bearing_outer_race": "C3", "bearing_inner_race": "C1", "bearing_ball": "C4", "bearing_cage": "C5",
+              "unbalance": "C0", "misalignment": "C2", "looseness": "C6", "gear_mesh": "C8"}
+    if diag.envelope_band_hz:
+        es = envelope_spectrum(rec, band=diag.envelope_band_hz)
+        fmax = 4 * max(tab.loc[tab.fault.str.startswith("bearing"), "expected_hz"].max(), 1.0)
+        sel = es.freq <= fmax
+        ax_e.plot(es.freq[sel], es.values[0, sel], lw=0.7, color="0.3")
+        for _, r in tab[tab.fault.str.startswith("bearing")].iterrows():
+            for k in (1, 2, 3):
+                ax_e.axvline(k * r.expected_hz, color=colors[r.fault], lw=0.7, ls="--")
+            ax_e.text(r.expected_hz, 0.98, f" {r.fault.split('_', 1)[1]} {r.confidence:.2f}",
+                      transform=ax_e.get_xaxis_transform(), rotation=90, va="top", fontsize=7, color=colors[r.fault])
+        ax_e.set_title(f"squared-envelope spectrum, band {diag.envelope_band_hz[0]:.0f}-{diag.envelope_band_hz[1]:.0f} "
+                       f"Hz: top = {diag.top}", fontsize=9)
+    s = amplitude_spectrum(rec)
+    f1 = (diag.speed.get("estimated_rpm") or diag.speed["declared_rpm"]) / 60
+    sel = s.freq <= 12 * f1
+    ax_s.plot(s.freq[sel], s.values[0, sel], lw=0.7, color="0.3")
+    for k in range(1, 11):
+        ax_s.axvline(k * f1, color="C0", lw=0.5, ls=":")
+    ax_s.set_xlabel("frequency [Hz]")
+    ax_s.set_title(f"spectrum with shaft orders 1X..10X (1X = {f1:.2f} Hz)", fontsize=9)
+    sev = diag.severity
+    from .monitor.machinery import ISO_10816_3
+    ab, bc, cd = ISO_10816_3[(sev["group"], sev["foundation"])]
+    top = cd * 1.5
+    for lo, hi, c, z in ((0, ab, "#3a3", "A"), (ab, bc, "#cc3", "B"), (bc, cd, "#e83", "C"), (cd, top, "#d33", "D")):
+        ax_g.bar(0, hi - lo, bottom=lo, color=c, width=0.6)
+        ax_g.text(0.35, (lo + hi) / 2, z, va="center")
+    v = sev.get("velocity_rms_mm_s")
+    if v is not None:
+        ax_g.plot([-0.35, 0.35], [min(v, top)] * 2, color="k", lw=3)
+        ax_g.set_title(f"ISO 10816-3\n{v:.2f} mm/s: zone {sev['zone']}", fontsize=9)
+    ax_g.set_xlim(-0.5, 0.6)
+    ax_g.set_ylim(0, top)
+    ax_g.set_xticks([])
+    ax_g.set_ylabel("velocity RMS [mm/s]")
+    return axes

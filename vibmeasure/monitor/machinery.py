@@ -169,6 +169,8 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
                 f"{fsr:g} Hz ({r * fsr:g} Hz): check the sampling rate"))
             flags.append("speed_inconsistent")
             break
+    if bearing is not None:
+        bf = bearing.frequencies(f1)  # at the estimated running speed
     if speed["consistent"] and snr1 < LINE_DB:
         speed["note"] = f"no 1X line within 3 % of the declared {rpm:g} rpm"
 
