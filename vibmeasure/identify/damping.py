@@ -77,6 +77,14 @@ def _halfpower_points(x, fs, band):
     sel = np.ones_like(f, bool) if band is None else (f >= band[0]) & (f <= band[1])
     sel[0] = False
     k = np.flatnonzero(sel)[int(np.argmax(P[sel]))]
+    f1, f2, _, _ = half_power_crossings(f, P, k, lower_msg="a half-power point lies outside the spectrum "
+                                        "(damping too high or the peak at the band edge)")
+    return f1, f2
+
+
+def half_power_crossings(freq, P, k, *, lower_msg: str):
+    """Frequencies where the power P falls to half its value at line k on either side, linearly
+    interpolated between lines; FitError when a crossing lies outside the data."""
     half = P[k] / 2
     lo = k
     while lo > 0 and P[lo] > half:
@@ -84,12 +92,13 @@ def _halfpower_points(x, fs, band):
     hi = k
     while hi < P.size - 1 and P[hi] > half:
         hi += 1
-    if lo == 0 or hi == P.size - 1:
-        raise FitError("half_power: a half-power point lies outside the spectrum (damping too high or the "
-                       "peak at the band edge)")
-    f1 = f[lo] + (half - P[lo]) * (f[lo + 1] - f[lo]) / (P[lo + 1] - P[lo])
-    f2 = f[hi - 1] + (half - P[hi - 1]) * (f[hi] - f[hi - 1]) / (P[hi] - P[hi - 1])
-    return float(f1), float(f2)
+    if P[lo] > half or freq[lo] <= 0:
+        raise FitError(f"half_power: {lower_msg}")
+    if P[hi] > half:
+        raise FitError("half_power: the upper half-power point lies beyond the data")
+    f1 = freq[lo] + (half - P[lo]) * (freq[lo + 1] - freq[lo]) / (P[lo + 1] - P[lo])
+    f2 = freq[hi - 1] + (half - P[hi - 1]) * (freq[hi] - freq[hi - 1]) / (P[hi] - P[hi - 1])
+    return float(f1), float(f2), lo, hi
 
 
 def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: float | None = None,

@@ -14,6 +14,7 @@ import numpy as np
 from ..core._validate import check_band
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import FRF, ModalEstimate, Spectrum
+from ._poles import pole_to_modal
 
 __all__ = ["fit_modes", "half_power_frf", "circle_fit", "mac", "synthesize_frf", "modal_crb"]
 
@@ -344,13 +345,8 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
     wn = np.hypot(sig, wd)
     fn = wn / (2 * np.pi)
     zeta = sig / wn
-    fn_std, zeta_std = np.empty(m), np.empty(m)
-    for k in range(m):
-        c2 = cov[2 * k:2 * k + 2, 2 * k:2 * k + 2]
-        g_wn = np.array([sig[k], wd[k]]) / wn[k]
-        g_z = np.array([wd[k] ** 2, -sig[k] * wd[k]]) / wn[k] ** 3
-        fn_std[k] = np.sqrt(max(g_wn @ c2 @ g_wn, 0)) / (2 * np.pi)
-        zeta_std[k] = np.sqrt(max(g_z @ c2 @ g_z, 0))
+    stds = np.array([pole_to_modal(sig[k], wd[k], cov[2 * k:2 * k + 2, 2 * k:2 * k + 2])[2:] for k in range(m)])
+    fn_std, zeta_std = stds[:, 0], stds[:, 1]
     # residues (n_out, m) in the FRF's own units (undo the weights)
     R = (coef[0:2 * m:2] + 1j * coef[1:2 * m:2]).T / sw[:, None]
     flags_mode, keep = [], []
@@ -460,14 +456,8 @@ def modal_crb(freq, *, fn, zeta, residues, noise_std) -> dict:
     coef[1:2 * fn.size:2] = R.imag.T
     J = _full_jacobian(w, theta, coef, sw)
     cov = np.linalg.inv(J.T @ J)
-    fn_std, zeta_std = [], []
-    for k in range(fn.size):
-        c2 = cov[2 * k:2 * k + 2, 2 * k:2 * k + 2]
-        g_wn = np.array([sig[k], wd[k]]) / wn[k]
-        g_z = np.array([wd[k] ** 2, -sig[k] * wd[k]]) / wn[k] ** 3
-        fn_std.append(np.sqrt(g_wn @ c2 @ g_wn) / (2 * np.pi))
-        zeta_std.append(np.sqrt(g_z @ c2 @ g_z))
-    return {"fn_std": np.array(fn_std), "zeta_std": np.array(zeta_std)}
+    stds = np.array([pole_to_modal(sig[k], wd[k], cov[2 * k:2 * k + 2, 2 * k:2 * k + 2])[2:] for k in range(fn.size)])
+    return {"fn_std": stds[:, 0], "zeta_std": stds[:, 1]}
 
 
 # ------------------------------------------------------------------------------------------------
@@ -518,21 +508,10 @@ def half_power_frf(obj, *, band=None, output=0, input=0) -> ModalEstimate:
     sel &= freq > 0
     if not sel.any():
         raise ParameterError(f"band={band!r} holds no line of the data")
+    from .damping import half_power_crossings
     k = int(np.flatnonzero(sel)[np.argmax(P[sel])])
-    half = P[k] / 2
-    lo = k
-    while lo > 0 and P[lo] > half:
-        lo -= 1
-    hi = k
-    while hi < P.size - 1 and P[hi] > half:
-        hi += 1
-    if P[lo] > half or freq[lo] <= 0 or lo == 0 and P[0] > half:
-        raise FitError("half_power: the lower half-power point does not exist (zeta > 0.38, or the peak sits "
-                       "at the start of the data)")
-    if P[hi] > half:
-        raise FitError("half_power: the upper half-power point lies beyond the data")
-    f1 = freq[lo] + (half - P[lo]) * (freq[lo + 1] - freq[lo]) / (P[lo + 1] - P[lo])
-    f2 = freq[hi - 1] + (half - P[hi - 1]) * (freq[hi] - freq[hi - 1]) / (P[hi] - P[hi - 1])
+    f1, f2, lo, hi = half_power_crossings(freq, P, k, lower_msg="the lower half-power point does not exist "
+                                          "(zeta > 0.38, or the peak sits at the start of the data)")
     df = float(freq[1] - freq[0])
     lines = (f2 - f1) / df
     if lines < 3:

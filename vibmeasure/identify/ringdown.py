@@ -21,6 +21,7 @@ from ..core._validate import as_record, check_band, clean_signal, response_chann
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import FLAG_TEXT, ModalEstimate
 from ._decay import clipped_mask, cycle_peaks, decay_start, noise_std, spectral_peak
+from ._poles import pole_to_modal
 
 __all__ = ["ringdown", "ringdown_crb"]
 
@@ -418,14 +419,8 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     wn = np.hypot(om, sig)
     fn = wn / (2 * np.pi)
     zeta = sig / wn
-    fn_std = np.empty(nm)
-    zeta_std = np.empty(nm)
-    for k in range(nm):
-        c2 = cov[4 * k:4 * k + 2, 4 * k:4 * k + 2]
-        g_wn = np.array([sig[k], om[k]]) / wn[k]
-        g_z = np.array([om[k] ** 2, -sig[k] * om[k]]) / wn[k] ** 3
-        fn_std[k] = np.sqrt(max(g_wn @ c2 @ g_wn, 0)) / (2 * np.pi)
-        zeta_std[k] = np.sqrt(max(g_z @ c2 @ g_z, 0))
+    stds = np.array([pole_to_modal(sig[k], om[k], cov[4 * k:4 * k + 2, 4 * k:4 * k + 2])[2:] for k in range(nm)])
+    fn_std, zeta_std = stds[:, 0].copy(), stds[:, 1].copy()
     scale = _colored_noise_scale(resid, w, fsr, om / (2 * np.pi), sig / np.pi, noise)
     fn_std *= scale
     zeta_std *= scale
@@ -815,8 +810,5 @@ def ringdown_crb(*, fn: float, zeta: float, fs: float, duration: float, amplitud
     m = a * c + b * sn
     J = np.column_stack([-t * m, t * (b * c - a * sn), c, sn])
     cov = s ** 2 * np.linalg.inv(J.T @ J)
-    c2 = cov[:2, :2]
-    g_wn = np.array([sig, om]) / wn
-    g_z = np.array([om ** 2, -sig * om]) / wn ** 3
-    return {"fn": fn, "zeta": zeta, "fn_std": float(np.sqrt(g_wn @ c2 @ g_wn) / (2 * np.pi)),
-            "zeta_std": float(np.sqrt(g_z @ c2 @ g_z)), "noise_std": float(s)}
+    _, _, fn_std, zeta_std = pole_to_modal(sig, om, cov[:2, :2])
+    return {"fn": fn, "zeta": zeta, "fn_std": fn_std, "zeta_std": zeta_std, "noise_std": float(s)}
