@@ -38,7 +38,7 @@ def main(n):
         false_alarms = n - counts["none"]["none"]
         print(f"\nSNR {snr} dB: correct {correct}/{n * len(FAULTS)} ({correct / (n * len(FAULTS)) * 100:.1f} %), "
               f"false alarms on healthy {false_alarms}/{n}")
-        print(f"{'truth \\ top':>20} " + " ".join(f"{c:>6}" for c in cols))
+        print(f"{'truth / top':>20} " + " ".join(f"{c:>6}" for c in cols))
         for f in FAULTS:
             print(f"{f:>20} " + " ".join(f"{counts[f][c]:>6}" for c in cols))
     data = Path(__file__).resolve().parents[2] / "shared" / "data" / "cwru"
