@@ -146,13 +146,9 @@ def _main_diagnose(args, out, err) -> int:
         if args.plot:
             import matplotlib
             matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
             from .plot import plot_diagnosis
             axes = plot_diagnosis(rec.select(0), diag)
-            try:
-                _atomic_savefig(axes[0].figure, args.plot)
-            finally:
-                plt.close(axes[0].figure)
+            _save_figure(axes[0].figure, args.plot)
     except (VibMeasureError, OSError) as exc:
         print(f"vibmeasure: error: {exc}", file=err)
         return 2
@@ -237,10 +233,7 @@ def _main_compare(args, out, err) -> int:
                     ax.axhline(sgn * args.rtol_fn * 100, color="C3", ls="--", lw=0.8)
                 ax.set_ylabel("fn deviation [%]")
                 ax.set_title(f"measured vs {'baseline' if args.baseline else 'model'}: {cmp.verdict}", fontsize=9)
-                try:
-                    _atomic_savefig(fig, args.plot)
-                finally:
-                    plt.close(fig)
+                _save_figure(fig, args.plot)
         except (VibMeasureError, OSError) as exc:
             print(f"vibmeasure: error: {exc}", file=err)
             return 2
@@ -301,17 +294,13 @@ def _main_frf(args, out, err) -> int:
             if args.plot:
                 import matplotlib
                 matplotlib.use("Agg")
-                import matplotlib.pyplot as plt
                 from .plot import plot_frf, plot_stabilisation
                 if est is not None:
                     ax = plot_stabilisation(est, frf=frf)
                     fig = ax.figure
                 else:
                     fig = plot_frf(frf)[0].figure
-                try:
-                    _atomic_savefig(fig, args.plot)
-                finally:
-                    plt.close(fig)
+                _save_figure(fig, args.plot)
         except (VibMeasureError, OSError) as exc:
             print(f"vibmeasure: error: {exc}", file=err)
             return 2
@@ -405,7 +394,6 @@ def _spectrum(args, out, err):
 
 
 def _spectrum_outputs(args, spec, found, band):
-    import numpy as np
     if args.csv:
         from .io._common import atomic_path
         df = spec.to_frame()
@@ -416,13 +404,20 @@ def _spectrum_outputs(args, spec, found, band):
     if args.plot:
         import matplotlib
         matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
         from .plot import plot_spectrum
         ax = plot_spectrum(spec, peaks=found[0] if found else None)
         if band:
             ax.set_xlim(*band)
-        _atomic_savefig(ax.figure, args.plot)
-        plt.close(ax.figure)
+        _save_figure(ax.figure, args.plot)
+
+
+def _save_figure(fig, path):
+    """Write the figure atomically, then close it (also when writing fails)."""
+    import matplotlib.pyplot as plt
+    try:
+        _atomic_savefig(fig, path)
+    finally:
+        plt.close(fig)
 
 
 def _atomic_savefig(fig, path):
@@ -474,13 +469,9 @@ def _ringdown(args, out):
 def _save_plot(path, rec, est):
     import matplotlib
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from .plot import plot_ringdown
     ax, _ = plot_ringdown(rec, est)
-    try:
-        _atomic_savefig(ax.figure, path)
-    finally:
-        plt.close(ax.figure)
+    _save_figure(ax.figure, path)
 
 
 def _report_text(args, rec, est, caught, out):

@@ -198,7 +198,6 @@ def _varpro_jac(theta, w, Hw):
     Y = np.vstack([Hw.real.T, Hw.imag.T])
     coef, *_ = np.linalg.lstsq(A, Y, rcond=None)
     iw = 1j * w
-    n_out = Y.shape[1]
     cols = []
     for r, l in enumerate(lam):
         da = 1 / (iw - l) ** 2

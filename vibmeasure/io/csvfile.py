@@ -155,7 +155,7 @@ def write_csv(path, rec: Record, *, time_column: bool = True) -> None:
     head = ["# vibmeasure record, schema 1", f"# fs_hz = {rec.fs!r}", f"# t0_s = {rec.t0!r}"]
     for c in rec.channels:
         head.append(f"# channel = {c.name}; {c.quantity}; {c.unit}; {c.location}")
-    cols = ([f"time [s]"] if time_column else []) + [f"{c.name} [{c.unit}]" if c.unit else c.name
+    cols = (["time [s]"] if time_column else []) + [f"{c.name} [{c.unit}]" if c.unit else c.name
                                                       for c in rec.channels]
     arr = np.vstack([rec.time, rec.data]).T if time_column else rec.data.T
     with atomic_path(path) as tmp:
