@@ -12,13 +12,12 @@ import time
 import warnings
 from pathlib import Path
 
-import numpy as np
 
 import vibmeasure as vm
 
 FAULTS = ["none", "unbalance", "misalignment", "looseness", "bearing_outer_race", "bearing_inner_race",
           "bearing_ball", "gear_mesh"]
-SNRS = [0, 10, 20]
+SNRS = [-10, 0, 10]
 SHORT = {"none": "none", "unbalance": "unbal", "misalignment": "misal", "looseness": "loose",
          "bearing_outer_race": "BPFO", "bearing_inner_race": "BPFI", "bearing_ball": "ball", "bearing_cage": "cage",
          "gear_mesh": "gear", "resonance": "reson"}

@@ -41,7 +41,7 @@ def in_memory():
     t_sp, (_, ref) = best_of(lambda: sg.welch(x, fs=1.0e4, **KW))
     t_vm, ours = best_of(lambda: vm.psd(rec, **KW))
     err = float(np.max(np.abs(ours.values[0] / ref - 1)))
-    print(f"PSD of 2^24 float64 samples (Hann, nperseg 4096, 50 % overlap, constant detrend)")
+    print("PSD of 2^24 float64 samples (Hann, nperseg 4096, 50 % overlap, constant detrend)")
     print(f"  scipy.signal.welch : {t_sp:7.3f} s  {n / t_sp / 1e6:7.1f} M samples/s")
     print(f"  vm.psd             : {t_vm:7.3f} s  {n / t_vm / 1e6:7.1f} M samples/s")
     print(f"  speed-up           : {t_sp / t_vm:7.2f} x   (target >= 4)   max relative difference {err:.1e} "
