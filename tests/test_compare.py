@@ -1,6 +1,5 @@
 """Measured versus model and baseline: end to end, verdicts, implied stiffness change, trends, storage."""
 import json
-import warnings
 
 import numpy as np
 import pytest

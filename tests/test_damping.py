@@ -1,5 +1,4 @@
 """Classic damping estimates (log decrement, Hilbert envelope, half-power) against closed forms."""
-import warnings
 
 import numpy as np
 import pytest

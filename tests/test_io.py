@@ -254,7 +254,6 @@ def test_unknown_missing_empty(tmp_path):
 
 
 def test_failed_write_leaves_nothing(tmp_path, rec2, monkeypatch):
-    import vibmeasure.io.hdf5 as h
     def boom(*a, **k):
         raise OSError("disk full")
     monkeypatch.setattr(h5py.File, "create_dataset", boom)

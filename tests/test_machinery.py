@@ -1,6 +1,5 @@
 """Machine diagnosis: bearing kinematics, severity zones, synthetic faults, CWRU records, bad input."""
 import json
-import warnings
 
 import numpy as np
 import pytest

@@ -19,7 +19,7 @@ from .monitor.compare import Comparison, History, compare
 from .monitor.machinery import Diagnosis, diagnose, severity_zone
 from .io import LazyRecord, read, read_frf, read_spectrum, write
 from .io import open_record as open  # noqa: A001  (vm.open: the documented name)
-from .signal.demod import envelope, envelope_spectrum
+from .signal.demod import envelope, envelope_spectrum, order_track, time_synchronous_average
 from .signal.peaks import harmonic_family, pick_peaks, sideband_family
 from .signal.preprocess import decimate, detrend, differentiate, integrate, resample
 from .signal.preprocess import filter  # noqa: A004  (vm.filter: Butterworth, zero-phase)
@@ -32,7 +32,7 @@ __all__ = [
     "VibMeasureError", "ParameterError", "UnitError", "FitError", "QualityWarning",
     "read", "write", "open", "read_frf", "read_spectrum",
     "amplitude_spectrum", "psd", "csd", "coherence", "spectrogram", "band_rms", "octave_bands",
-    "pick_peaks", "harmonic_family", "sideband_family", "envelope", "envelope_spectrum",
+    "pick_peaks", "harmonic_family", "sideband_family", "envelope", "envelope_spectrum", "order_track", "time_synchronous_average",
     "detrend", "filter", "decimate", "resample", "integrate", "differentiate",
     "ringdown", "ringdown_crb", "estimate_frf", "impact_frf", "find_hits", "fit_modes", "circle_fit", "mac",
     "modal_crb", "synthesize_frf", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",

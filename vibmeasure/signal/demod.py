@@ -10,7 +10,7 @@ from ..core.errors import ParameterError
 from ..core.record import Channel, Record
 from ..core.results import Spectrum
 
-__all__ = ["envelope", "envelope_spectrum"]
+__all__ = ["envelope", "envelope_spectrum", "order_track", "time_synchronous_average"]
 
 
 def _band(rec, band):
@@ -56,3 +56,67 @@ def envelope_spectrum(rec, *, band, channel=None, window="hann", nperseg: int | 
     params = dict(spec.params, band_hz=tuple(_band(rec, band)), squared=True)
     return Spectrum(spec.freq, spec.values, "envelope", power_unit(c.unit, density=False),
                     (c.name,), c.quantity, params)
+
+
+def _shaft_angle(rec, *, tach=None, rpm_profile=None, pulses_per_rev: int = 1, tach_level: float | None = None):
+    """Shaft angle (revolutions) at every sample, from tachometer pulses or an rpm profile."""
+    t = np.arange(rec.n_samples) / rec.fs
+    if (tach is None) == (rpm_profile is None):
+        raise ParameterError("give exactly one of tach (pulse channel name or array) and rpm_profile")
+    if tach is not None:
+        p = rec.channel(tach) if isinstance(tach, (str, int)) else np.asarray(tach, float)
+        if p.shape != t.shape:
+            raise ParameterError(f"tach has {p.size} samples; the record has {t.size}")
+        lvl = (p.max() + p.min()) / 2 if tach_level is None else tach_level
+        up = np.flatnonzero((p[1:] >= lvl) & (p[:-1] < lvl))
+        if up.size < 3:
+            raise ParameterError(f"tach: {up.size} pulse(s) found at level {lvl:g}; at least 3 are needed")
+        # sub-sample crossing times, then the angle is linear between pulses (cubic would overshoot)
+        tc = (up + (lvl - p[up]) / (p[up + 1] - p[up])) / rec.fs
+        rev = np.arange(tc.size) / pulses_per_rev
+        return np.interp(t, tc, rev, left=np.nan, right=np.nan)
+    prof = np.asarray(rpm_profile, float)
+    if prof.shape != t.shape or np.any(~np.isfinite(prof)) or np.any(prof <= 0):
+        raise ParameterError(f"rpm_profile must hold one positive rpm per sample ({t.size})")
+    from scipy.integrate import cumulative_trapezoid
+    return cumulative_trapezoid(prof / 60.0, t, initial=0.0)
+
+
+def order_track(rec, *, channel=None, tach=None, rpm_profile=None, samples_per_rev: int = 64,
+                pulses_per_rev: int = 1, fs: float | None = None) -> Record:
+    """Angular resampling: the channel at equal shaft-angle steps (``samples_per_rev`` per
+    revolution). The result's ``fs`` is in samples per revolution, so its spectrum is an order
+    spectrum (1.0 = 1X) however the speed varied."""
+    rec = as_record(rec, fs=fs)
+    i = response_channel(rec, channel)
+    if isinstance(samples_per_rev, bool) or not isinstance(samples_per_rev, (int, np.integer)) or samples_per_rev < 4:
+        raise ParameterError(f"samples_per_rev={samples_per_rev!r} must be an integer >= 4")
+    ang = _shaft_angle(rec, tach=tach, rpm_profile=rpm_profile, pulses_per_rev=pulses_per_rev)
+    ok = np.isfinite(ang)
+    a0, a1 = ang[ok][0], ang[ok][-1]
+    grid = np.arange(np.ceil(a0 * samples_per_rev), np.floor(a1 * samples_per_rev)) / samples_per_rev
+    if grid.size < 4 * samples_per_rev:
+        raise ParameterError("fewer than 4 revolutions are covered by the speed information")
+    t = np.arange(rec.n_samples) / rec.fs
+    t_grid = np.interp(grid, ang[ok], t[ok])
+    from scipy.interpolate import CubicSpline
+    x = CubicSpline(t, rec.data[i])(t_grid)
+    c = rec.channels[i]
+    return Record(x, float(samples_per_rev), (Channel(f"{c.name}.orders", c.quantity, c.unit, c.location),),
+                  meta=dict(rec.meta, domain="angle", samples_per_rev=samples_per_rev, first_rev=float(grid[0])),
+                  history=rec.history + (f"order_track({samples_per_rev} samples/rev)",))
+
+
+def time_synchronous_average(rec, *, channel=None, tach=None, rpm_profile=None, samples_per_rev: int = 256,
+                             pulses_per_rev: int = 1, fs: float | None = None) -> Record:
+    """Average of the angle-resampled signal over whole revolutions: what turns with the shaft stays,
+    the rest (noise, other shafts, bearing impacts that slip) averages out by about 1/sqrt(revs).
+    Returns one revolution (``samples_per_rev`` samples, fs in samples per revolution)."""
+    ang_rec = order_track(rec, channel=channel, tach=tach, rpm_profile=rpm_profile, samples_per_rev=samples_per_rev,
+                          pulses_per_rev=pulses_per_rev, fs=fs)
+    start = int((-ang_rec.meta["first_rev"] * samples_per_rev) % samples_per_rev)
+    x = ang_rec.data[0, start:]
+    n_rev = x.size // samples_per_rev
+    avg = x[: n_rev * samples_per_rev].reshape(n_rev, samples_per_rev).mean(axis=0)
+    return ang_rec.replace(data=avg, meta=dict(ang_rec.meta, revolutions_averaged=n_rev),
+                           note=f"time_synchronous_average({n_rev} revolutions)")
