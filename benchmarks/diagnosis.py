@@ -30,7 +30,7 @@ def main(n):
         counts = {f: dict.fromkeys(cols, 0) for f in FAULTS}
         for fault in FAULTS:
             for seed in range(n):
-                rec = vm.synth.machine(fault=fault, snr_db=snr, seed=1000 * snr + seed, duration=6.0)
+                rec = vm.synth.machine(fault=fault, snr_db=snr, seed=1000 * (snr + 100) + seed, duration=6.0)
                 d = vm.diagnose(rec, bearing="6205-2RS", gear=32)
                 counts[fault][SHORT.get(d.top, d.top)] += 1
         correct = sum(counts[f][SHORT[f]] for f in FAULTS)
