@@ -16,16 +16,16 @@ from pathlib import Path
 import vibmeasure as vm
 
 FAULTS = ["none", "unbalance", "misalignment", "looseness", "bearing_outer_race", "bearing_inner_race",
-          "bearing_ball", "gear_mesh"]
+          "bearing_ball", "gear_mesh", "resonance"]
 SNRS = [-10, 0, 10]
 SHORT = {"none": "none", "unbalance": "unbal", "misalignment": "misal", "looseness": "loose",
          "bearing_outer_race": "BPFO", "bearing_inner_race": "BPFI", "bearing_ball": "ball", "bearing_cage": "cage",
-         "gear_mesh": "gear", "resonance": "reson"}
+         "gear_mesh": "gear", "resonance": "reson", "electrical": "elec"}
 
 
 def main(n):
     warnings.simplefilter("ignore", vm.QualityWarning)
-    cols = [SHORT[f] for f in FAULTS] + ["cage"]
+    cols = [SHORT[f] for f in FAULTS] + ["cage", "elec"]
     for snr in SNRS:
         counts = {f: dict.fromkeys(cols, 0) for f in FAULTS}
         for fault in FAULTS:

@@ -43,7 +43,7 @@ def test_severity_zones_from_a_known_1x(group, foundation, bounds):
 
 
 @pytest.mark.parametrize("fault", ["none", "unbalance", "misalignment", "looseness", "bearing_outer_race",
-                                   "bearing_inner_race", "bearing_ball", "gear_mesh"])
+                                   "bearing_inner_race", "bearing_ball", "gear_mesh", "resonance"])
 def test_synthetic_faults(fault):
     # the benchmark runs 20 seeds x 3 SNRs; here 2 seeds at 15 dB
     for seed in range(2):
@@ -106,3 +106,14 @@ def test_bad_input():
         vm.diagnose(rec, bearing="6309")
     with pytest.raises(vm.ParameterError, match="machine_group"):
         vm.diagnose(rec, machine_group=3)
+
+
+def test_twice_line_frequency():
+    fs, rpm = 5000.0, 1480.0  # 24.67 Hz shaft: 100 Hz is not one of its orders
+    t = np.arange(int(8 * fs)) / fs
+    x = 0.01 * np.sin(2 * np.pi * rpm / 60 * t) + 0.2 * np.sin(2 * np.pi * 100.0 * t)
+    x += 0.005 * np.random.default_rng(0).normal(size=t.size)
+    rec = vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="g")
+    d = vm.diagnose(rec, rpm=rpm, line_frequency=50.0)
+    assert d.top == "electrical"
+    assert vm.diagnose(rec, rpm=rpm).top != "electrical"  # without a line frequency there is no such check

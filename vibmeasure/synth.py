@@ -234,7 +234,7 @@ def modal_response(force, *, fs: float, fn, zeta, shapes, input_dof: int = 0, qu
 
 
 _FAULTS = ("none", "unbalance", "misalignment", "looseness", "bearing_outer_race", "bearing_inner_race",
-           "bearing_ball", "gear_mesh")
+           "bearing_ball", "gear_mesh", "resonance")
 
 
 def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, duration: float = 10.0,
@@ -246,7 +246,7 @@ def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, du
     misalignment (strong 2X beside 1X), looseness (many harmonics and 0.5X sub-harmonics), bearing
     defects (impacts at BPFO/BPFI/BSF with 1 % slip jitter exciting a structural resonance; inner
     race and ball faults amplitude-modulated at 1X and FTF), gear mesh (teeth x 1X with 1X
-    sidebands). ``severity`` scales the fault, ``snr_db`` is the fault signal's power over the noise.
+    sidebands), resonance (a structural mode 6 % above 1X amplifying 1X and the broadband forces). ``severity`` scales the fault, ``snr_db`` is the fault signal's power over the noise.
     The fault-free part is in g; meta holds rpm and the truth.
     """
     from .models.bearing import BEARINGS, Bearing
@@ -300,6 +300,14 @@ def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, du
         fm = gear_teeth * f1
         sig = 0.3 * (1 + 0.5 * np.cos(2 * np.pi * f1 * t)) * np.sin(2 * np.pi * fm * t + ph()) \
             + 0.1 * np.sin(2 * np.pi * 2 * fm * t + ph())
+    elif fault == "resonance":
+        # a structural mode (zeta 0.04) 6 % above 1X: the running speed's force and the broadband
+        # forces both come out amplified, the latter as a hump in the noise floor
+        from scipy.signal import cont2discrete, lfilter
+        wr = 2 * np.pi * 1.06 * f1
+        bz, az, _ = cont2discrete(([wr ** 2], [1.0, 2 * 0.04 * wr, wr ** 2]), 1 / fs, method="zoh")
+        drive = 0.02 * np.sin(2 * np.pi * f1 * t + ph()) + 0.05 * rng.normal(size=n)
+        sig = lfilter(np.ravel(bz), az, drive) * 2.0
     sig = severity * sig
     p_sig = np.mean(sig ** 2) if fault != "none" else np.mean((0.3 * np.ones(1)) ** 2) / 2
     noise = rng.normal(0, np.sqrt(p_sig / 10 ** (snr_db / 10)), n)

@@ -39,7 +39,7 @@ def severity_zone(v_rms_mm_s: float, *, group: int = 2, foundation: str = "rigid
 @dataclass(frozen=True)
 class Diagnosis:
     """``top`` (none, unbalance, misalignment, looseness, bearing_outer_race, bearing_inner_race,
-    bearing_ball, bearing_cage, gear_mesh), its ``confidence`` and ``reason``; ``faults`` (table per
+    bearing_ball, bearing_cage, gear_mesh, resonance, electrical), its ``confidence`` and ``reason``; ``faults`` (table per
     fault family), ``speed`` (estimated rpm and consistency), ``severity`` (ISO zone), ``flags``."""
 
     top: str
@@ -94,13 +94,15 @@ def _kurtogram_band(x, fs, f_lo):
 
 
 def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_group: int | None = None,
-             foundation: str | None = None, channel=None, band=None, fs: float | None = None):
+             foundation: str | None = None, channel=None, band=None, line_frequency: float | None = None,
+             fs: float | None = None):
     """Diagnose a rotating machine from an acceleration record.
 
     ``rpm`` is the declared shaft speed (default: the record's meta["rpm"]); ``bearing`` a
     vm.Bearing or a catalogue name ("6205-2RS", "6203-2RS"); ``gear`` a tooth count or vm.Gear;
     ``machine_group`` (1 or 2) and ``foundation`` ("rigid", "flexible") select the ISO 10816-3
     zones (default group 2, rigid). ``band`` fixes the envelope band (default: most impulsive band).
+    ``line_frequency`` (50 or 60 Hz) adds the electrical check at twice the line frequency.
     """
     rec = as_record(rec, fs=fs)
     idx = response_channel(rec, channel)
@@ -219,6 +221,41 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         loose *= 0.3  # the sub-harmonics are explained by the sampling-rate contradiction
     add("looseness", f1, None, None, float(len(harmonics)), loose,
         f"{len(harmonics)} harmonics above 2X, sub-harmonics at {subs or 'none'}")
+
+    # --- resonance: the noise floor raised into a hump around a shaft order ---------------------------
+    res_conf, res_f, res_db = 0.0, None, 0.0
+    for k in (1, 2, 3, 4):
+        if k not in order or order[k][2] < LINE_DB:
+            continue
+        fk = k * f1
+        half = max(3.0, 0.1 * fk)
+        local = (np.abs(f - fk) <= half) & (np.abs(f - fk) > 4 * df)      # beside the tone, inside a hump
+        far = (f > 0.3 * fk) & (f < 3 * fk) & (np.abs(f - fk) > 0.3 * fk)   # the floor away from it
+        for j in order:                                                    # other order lines are not floor
+            far &= np.abs(f - j * f1) > 4 * df
+        if local.sum() < 8 or far.sum() < 8:
+            continue
+        db = float(20 * np.log10(np.median(V[local]) / max(np.median(V[far]), 1e-300)))
+        if db > res_db:
+            res_db, res_f = db, float(fk)
+    if res_f is not None:
+        res_conf = level * float(np.clip((res_db - 10) / 6, 0, 1))
+        # an order amplified by a mode next to it is the resonance's doing, not unbalance/misalignment
+        for r in rows:
+            if (r["fault"] == "unbalance" and abs(res_f - f1) < 0.5 * f1) or \
+                    (r["fault"] == "misalignment" and abs(res_f - 2 * f1) < 0.5 * f1):
+                r["confidence"] = float(r["confidence"] * (1 - res_conf))
+                r["note"] += f"; the order sits on a resonance (hump {res_db:.1f} dB)" if res_conf > 0 else ""
+    add("resonance", res_f, res_f, None, res_db, res_conf,
+        f"noise floor raised {res_db:.1f} dB around the order at {res_f or 0:.1f} Hz (a structural mode there)")
+
+    # --- twice line frequency (electrical) -------------------------------------------------------------
+    if line_frequency is not None:
+        lf = positive(line_frequency, "line_frequency")
+        fo, am, db = _line(f, A, 2 * lf, max(2.5 * df, 0.002 * lf), max(5.0, 10 * df))
+        add("electrical", 2 * lf, fo, am, db, level * float(np.clip((db - LINE_DB) / 12, 0, 1)) *
+            (abs(2 * lf - round(2 * lf / f1) * f1) > max(3 * df, 0.01 * f1)),  # not a shaft order in disguise
+            f"2 x line frequency ({2 * lf:g} Hz) line {db:.1f} dB")
 
     # --- bearings (squared-envelope spectrum) -----------------------------------------------------
     env_band = ()
