@@ -117,6 +117,7 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--bearing", help="catalogue bearing (6205-2RS, 6203-2RS)")
     g.add_argument("--bearing-geometry", metavar="N,d,D,angle", help="balls, ball and pitch diameter, angle (deg)")
     dg.add_argument("--gear", type=int, metavar="TEETH", help="teeth of a gear on this shaft")
+    dg.add_argument("--line-frequency", type=float, choices=(50.0, 60.0), help="mains frequency: check 2 x line")
     dg.add_argument("--group", type=int, choices=(1, 2), default=2, help="ISO 10816-3 machine group (default 2)")
     dg.add_argument("--foundation", choices=("rigid", "flexible"), default="rigid")
     dg.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
@@ -142,7 +143,7 @@ def _main_diagnose(args, out, err) -> int:
                 raise VibMeasureError(f"--bearing-geometry {args.bearing_geometry!r} must be N,d,D,angle") from None
             bearing = Bearing(int(n), d, D, ang)
         diag = diagnose(rec, rpm=args.rpm, bearing=bearing, gear=args.gear, machine_group=args.group,
-                        foundation=args.foundation, channel=0)
+                        foundation=args.foundation, channel=0, line_frequency=args.line_frequency)
         if args.plot:
             import matplotlib
             matplotlib.use("Agg")
