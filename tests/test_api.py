@@ -45,3 +45,30 @@ def test_library_never_prints():
             if re.match(r"\s*print\(", line):
                 offenders.append(f"{p.name}:{i}")
     assert offenders == []
+
+
+def _bad_input_cases():
+    import numpy as np
+    rec = vm.synth.free_decay(fn=10.0, zeta=0.02, fs=1000.0, duration=3.0)
+    frf = vm.synth.modal_frf(np.linspace(1, 50, 200), fn=[10.0], zeta=[0.02], shapes=[[1.0]])
+    spec = vm.amplitude_spectrum(rec)
+    return {
+        "FRF.select index": (lambda: frf.select(outputs=5), "out of range"),
+        "harmonic_family channel": (lambda: vm.harmonic_family(spec, 10.0, channel="nope"), "channel='nope'"),
+        "sideband_family channel": (lambda: vm.sideband_family(spec, 10.0, 1.0, channel=7), "channel=7"),
+        "fit_modes input": (lambda: vm.fit_modes(frf, band=(2, 40), input="zz"), "input='zz'"),
+        "half_power output": (lambda: vm.half_power(frf, channel=3), "output=3"),
+        "modal_crb residues": (lambda: vm.modal_crb(np.linspace(1, 50, 100), fn=[10.0], zeta=[0.02],
+                                                    residues=np.ones((1, 2)), noise_std=[0.1]), "residues must be"),
+        "update_sdof mode": (lambda: vm.models.update_sdof(vm.ringdown(rec), m=1.0, mode=5), "mode=5"),
+        "read_spectrum missing": (lambda: vm.read_spectrum("no/such/file.lvm"), "does not exist"),
+        "envelope order": (lambda: vm.envelope(rec, band=(100, 200), order=0), "order=0"),
+        "Spectrum.channel": (lambda: spec.channel("nope"), "channel='nope'"),
+    }
+
+
+@pytest.mark.parametrize("name", sorted(_bad_input_cases()))
+def test_bad_input_is_a_parameter_error_naming_the_argument(name):
+    call, match = _bad_input_cases()[name]
+    with pytest.raises(vm.ParameterError, match=match):
+        call()

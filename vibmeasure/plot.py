@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .core._validate import response_channel
+from .core._validate import name_index, response_channel
 from .core.errors import ParameterError
 from .core.record import Record
 from .core.results import ModalEstimate
@@ -91,8 +91,7 @@ def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: b
         raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
     if ax is None:
         _, ax = plt.subplots(figsize=(9, 4.5))
-    rows = range(spec.n_channels) if channel is None else [spec.channels.index(channel)
-                                                           if isinstance(channel, str) else channel]
+    rows = range(spec.n_channels) if channel is None else [name_index(spec.channels, channel)]
     for i in rows:
         ax.plot(spec.freq, np.abs(spec.values[i]), lw=0.7, label=spec.channels[i])
     if peaks is not None and len(peaks):
@@ -121,8 +120,8 @@ def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
     from .core.results import FRF
     if not isinstance(frf, FRF):
         raise ParameterError(f"frf must be a vm.FRF, got {type(frf).__name__}")
-    o = frf.outputs.index(output) if isinstance(output, str) else output
-    i = frf.inputs.index(input) if isinstance(input, str) else input
+    o = name_index(frf.outputs, output, what="output")
+    i = name_index(frf.inputs, input, what="input")
     if axes is None:
         fig, axes = plt.subplots(3, 1, sharex=True, figsize=(9, 7), gridspec_kw={"height_ratios": [3, 1.5, 1]})
     am, ap, ac = axes
@@ -155,8 +154,8 @@ def plot_nyquist(frf, *, output=0, input=0, band=None, ax=None):
     import matplotlib.pyplot as plt
     if ax is None:
         _, ax = plt.subplots(figsize=(5.5, 5.5))
-    o = frf.outputs.index(output) if isinstance(output, str) else output
-    i = frf.inputs.index(input) if isinstance(input, str) else input
+    o = name_index(frf.outputs, output, what="output")
+    i = name_index(frf.inputs, input, what="input")
     sel = np.ones(frf.freq.size, bool) if band is None else (frf.freq >= band[0]) & (frf.freq <= band[1])
     h = frf.h[o, i, sel]
     ax.plot(h.real, h.imag, ".-", ms=3, lw=0.6)

@@ -7,7 +7,8 @@ import numpy as np
 from .errors import ParameterError
 from .record import Record
 
-__all__ = ["as_record", "response_channel", "clean_signal", "check_band", "positive"]
+__all__ = ["as_record", "response_channel", "clean_signal", "check_band", "positive", "name_index",
+           "select_names"]
 
 
 def as_record(obj, *, fs: float | None = None, name: str = "rec") -> Record:
@@ -74,3 +75,35 @@ def positive(value, name: str, *, allow_zero: bool = False) -> float:
     if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
         raise ParameterError(f"{name}={value!r} must be finite and {'>= 0' if allow_zero else '> 0'}")
     return v
+
+
+def name_index(names, which, *, what: str = "channel") -> int:
+    """Position of ``which`` (a name or an index) among ``names``; anything else is a ParameterError."""
+    names = list(names)
+    if isinstance(which, (int, np.integer)) and not isinstance(which, bool):
+        if not -len(names) <= which < len(names):
+            raise ParameterError(f"{what}={which} is out of range: there are {len(names)} ({names})")
+        return int(which) % len(names)
+    if which not in names:
+        raise ParameterError(f"{what}={which!r} is not one of {names}")
+    return names.index(which)
+
+
+def select_names(available, wanted, *, source: str) -> list[int]:
+    """Positions of the wanted channels (names or indices; None for all) among ``available``."""
+    available = list(available)
+    if wanted is None:
+        return list(range(len(available)))
+    if isinstance(wanted, (str, int, np.integer)):
+        wanted = [wanted]
+    out = []
+    for w in wanted:
+        if isinstance(w, (int, np.integer)) and not isinstance(w, bool):
+            if not 0 <= w < len(available):
+                raise ParameterError(f"channels={wanted!r}: index {w} out of range for {len(available)} channels")
+            out.append(int(w))
+        elif w in available:
+            out.append(available.index(w))
+        else:
+            raise ParameterError(f"channels={wanted!r}: {w!r} is not in {source}; it has {available}")
+    return out

@@ -203,11 +203,8 @@ class Spectrum:
         return self.values.shape[0]
 
     def channel(self, channel: str | int = 0) -> np.ndarray:
-        if isinstance(channel, str):
-            if channel not in self.channels:
-                raise ParameterError(f"channel={channel!r} is not in this spectrum; channels are {list(self.channels)}")
-            channel = self.channels.index(channel)
-        return self.values[channel]
+        from ._validate import name_index
+        return self.values[name_index(self.channels, channel)]
 
     def to_frame(self):
         """A pandas table: a freq_hz column and one column per channel."""
@@ -371,19 +368,10 @@ class FRF:
         """A sub-FRF with the named (or indexed) outputs and inputs."""
         import dataclasses
 
+        from ._validate import select_names
+
         def pick(names, want, what):
-            if want is None:
-                return list(range(len(names)))
-            want = [want] if isinstance(want, (str, int)) else list(want)
-            out = []
-            for w in want:
-                if isinstance(w, int):
-                    out.append(w)
-                elif w in names:
-                    out.append(names.index(w))
-                else:
-                    raise ParameterError(f"{what}={w!r} is not in this FRF; it has {list(names)}")
-            return out
+            return select_names(names, want, source=f"this FRF's {what}s")
         io_, ii = pick(self.outputs, outputs, "output"), pick(self.inputs, inputs, "input")
         return dataclasses.replace(
             self, h=self.h[np.ix_(io_, ii)], outputs=tuple(self.outputs[i] for i in io_),

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core._validate import check_band
+from ..core._validate import check_band, name_index
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import FRF, ModalEstimate, Spectrum
 from ._poles import pole_to_modal
@@ -38,9 +38,7 @@ def _band_lines(frf: FRF, band, inp):
         raise ParameterError(f"band={band!r} must have lo < hi")
     if hi > frf.freq[-1] + 1e-9 or lo < frf.freq[0] - 1e-9:
         raise ParameterError(f"band={band!r} lies outside the FRF's {frf.freq[0]:g}..{frf.freq[-1]:g} Hz")
-    ii = frf.inputs.index(inp) if isinstance(inp, str) else int(inp)
-    if not 0 <= ii < frf.n_inputs:
-        raise ParameterError(f"input={inp!r} is not in this FRF; it has {list(frf.inputs)}")
+    ii = name_index(frf.inputs, inp, what="input")
     sel = (frf.freq >= lo) & (frf.freq <= hi) & (frf.freq > 0)
     H = frf.h[:, ii, sel]
     bad = ~np.isfinite(H).all(axis=0)
@@ -445,11 +443,18 @@ def modal_crb(freq, *, fn, zeta, residues, noise_std) -> dict:
     w = 2 * np.pi * f
     fn = np.atleast_1d(np.asarray(fn, float))
     zeta = np.atleast_1d(np.asarray(zeta, float))
-    R = np.asarray(residues, complex)  # (n_out, m)
+    R = np.atleast_2d(np.asarray(residues, complex))  # (n_out, m)
+    s_o = np.atleast_1d(np.asarray(noise_std, float))
+    if zeta.shape != fn.shape:
+        raise ParameterError(f"zeta has {zeta.size} values for {fn.size} modes")
+    if R.shape[1] != fn.size:
+        raise ParameterError(f"residues must be (n_outputs, n_modes={fn.size}), got shape {R.shape}")
+    if s_o.shape != (R.shape[0],) or np.any(~np.isfinite(s_o)) or np.any(s_o <= 0):
+        raise ParameterError(f"noise_std must hold one positive std per output ({R.shape[0]}), got {s_o.tolist()}")
     wn = 2 * np.pi * fn
     sig, wd = zeta * wn, wn * np.sqrt(1 - zeta ** 2)
     theta = np.column_stack([sig, wd]).ravel()
-    sw = 1 / (np.asarray(noise_std, float) / np.sqrt(2))  # real and imaginary parts each s / sqrt 2
+    sw = 1 / (s_o / np.sqrt(2))  # real and imaginary parts each s / sqrt 2
     coef = np.zeros((2 * fn.size + 6, R.shape[0]))
     coef[0:2 * fn.size:2] = R.real.T
     coef[1:2 * fn.size:2] = R.imag.T
@@ -485,13 +490,13 @@ def half_power_frf(obj, *, band=None, output=0, input=0) -> ModalEstimate:
     A spectrum is treated as accelerance when it measures acceleration, else as receptance.
     """
     if isinstance(obj, FRF):
-        o = obj.outputs.index(output) if isinstance(output, str) else output
-        i = obj.inputs.index(input) if isinstance(input, str) else input
+        o = name_index(obj.outputs, output, what="output")
+        i = name_index(obj.inputs, input, what="input")
         freq, P, form = obj.freq, np.abs(obj.h[o, i]) ** 2, obj.form
         coh = obj.coherence[o] if obj.coherence is not None else None
     elif isinstance(obj, Spectrum):
         freq = obj.freq
-        ch = obj.channels.index(output) if isinstance(output, str) else output
+        ch = name_index(obj.channels, output, what="channel")
         v = np.abs(obj.values[ch])
         P = v if obj.kind in ("psd", "power") else v ** 2
         form = "accelerance" if obj.quantity == "acceleration" else "receptance"
@@ -549,8 +554,8 @@ def circle_fit(frf: FRF, *, band, output=0, input=0) -> ModalEstimate:
         raise ParameterError(f"frf must be a vm.FRF, got {type(frf).__name__}")
     lo, hi = check_band(band, 2 * frf.freq[-1] + 1e-9)
     mob = frf.to("mobility") if frf.form in ("receptance", "accelerance") else frf
-    o = frf.outputs.index(output) if isinstance(output, str) else output
-    i = frf.inputs.index(input) if isinstance(input, str) else input
+    o = name_index(frf.outputs, output, what="output")
+    i = name_index(frf.inputs, input, what="input")
     sel = (frf.freq >= lo) & (frf.freq <= hi) & (frf.freq > 0)
     if sel.sum() < 6:
         raise FitError(f"circle_fit: band={band!r} holds {int(sel.sum())} lines; at least 6 are needed")

@@ -99,4 +99,9 @@ def read_spectrum(path: str | os.PathLike):
     """Read a spectrum stored as text by LabVIEW (.lvm, X column in Hz); dB values (re 1 unit)
     become linear amplitudes. Returns a vm.Spectrum of kind "amplitude"."""
     from .lvm import read_lvm_spectrum
-    return read_lvm_spectrum(path)
+    p = Path(path)
+    if not p.exists():
+        raise ParameterError(f"path={str(path)!r} does not exist")
+    if p.suffix.lower() != ".lvm":
+        raise ParameterError(f"path={str(path)!r}: spectra are read from LabVIEW .lvm exports, not {p.suffix!r}")
+    return read_lvm_spectrum(p)

@@ -100,21 +100,3 @@ def make_record(data, fs, names, *, quantity=None, unit=None, quantities=None, u
             q = _units.quantity_of(u)
         chans.append(Channel(str(nm), q, u))
     return Record(data, fs, tuple(chans), t0=t0, meta=meta or {}, history=(f"read {source}",))
-
-
-def select_names(available: list[str], wanted, *, source: str) -> list[int]:
-    if wanted is None:
-        return list(range(len(available)))
-    if isinstance(wanted, (str, int)):
-        wanted = [wanted]
-    out = []
-    for w in wanted:
-        if isinstance(w, int) and not isinstance(w, bool):
-            if not 0 <= w < len(available):
-                raise ParameterError(f"channels={wanted!r}: index {w} out of range for {len(available)} channels")
-            out.append(w)
-        elif w in available:
-            out.append(available.index(w))
-        else:
-            raise ParameterError(f"channels={wanted!r}: {w!r} is not in {source}; it has {available}")
-    return out

@@ -10,7 +10,8 @@ import numpy as np
 
 from ..core.errors import ParameterError
 from ..core.record import Record
-from ._common import atomic_path, fs_from_time, make_record, require_fs, select_names
+from ..core._validate import select_names
+from ._common import atomic_path, fs_from_time, make_record, require_fs
 
 _FS_KEYS = ("fs", "fs_hz", "sampling_rate", "sample_rate", "samplerate", "sampling_frequency")
 _TIME_NAMES = ("time", "t", "zeit", "seconds", "time_s", "timestamp")

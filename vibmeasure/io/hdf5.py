@@ -16,7 +16,8 @@ import numpy as np
 
 from ..core.errors import ParameterError
 from ..core.record import Channel, Record
-from ._common import atomic_path, make_record, require_fs, select_names
+from ..core._validate import select_names
+from ._common import atomic_path, make_record, require_fs
 
 SCHEMA = "vibmeasure.record"
 SCHEMA_VERSION = 1

@@ -10,7 +10,8 @@ import numpy as np
 from ..core.errors import ParameterError, UnitError
 from ..core import units as _units
 from ..core.record import Record
-from ._common import make_record, require_fs, select_names
+from ..core._validate import select_names
+from ._common import make_record, require_fs
 
 _END = "***End_of_Header***"
 

@@ -11,7 +11,8 @@ import numpy as np
 from ..core.errors import ParameterError, UnitError
 from ..core import units as _units
 from ..core.record import Record
-from ._common import make_record, select_names
+from ..core._validate import select_names
+from ._common import make_record
 
 _QUANTITY = {8: "displacement", 11: "velocity", 12: "acceleration", 9: "force", 13: "force"}
 

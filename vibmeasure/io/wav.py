@@ -9,7 +9,8 @@ import numpy as np
 
 from ..core.errors import ParameterError
 from ..core.record import Record
-from ._common import atomic_path, make_record, select_names
+from ..core._validate import select_names
+from ._common import atomic_path, make_record
 
 _FULL_SCALE = {np.dtype("int16"): 32768.0, np.dtype("int32"): 2147483648.0, np.dtype("uint8"): 128.0}
 

@@ -18,6 +18,8 @@ def update_sdof(est: ModalEstimate, *, m: float, mode: int = 0) -> dict:
     if not isinstance(est, ModalEstimate):
         raise ParameterError(f"est must be a vm.ModalEstimate, got {type(est).__name__}")
     m = positive(m, "m")
+    if isinstance(mode, bool) or not isinstance(mode, (int, np.integer)) or not 0 <= mode < est.n_modes:
+        raise ParameterError(f"mode={mode!r} must be an index of the estimate's {est.n_modes} mode(s)")
     fn, z = float(est.fn[mode]), float(est.zeta[mode])
     fs, zs = float(np.nan_to_num(est.fn_std[mode])), float(np.nan_to_num(est.zeta_std[mode]))
     if not (np.isfinite(fn) and fn > 0 and np.isfinite(z) and z >= 0):

@@ -27,6 +27,8 @@ def envelope(rec, *, band, channel=None, order: int = 4, fs: float | None = None
     """Envelope of one channel: zero-phase Butterworth band-pass, then |analytic signal|."""
     rec = as_record(rec, fs=fs)
     lo, hi = _band(rec, band)
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or not 1 <= order <= 12:
+        raise ParameterError(f"order={order!r} must be an integer from 1 to 12")
     i = response_channel(rec, channel)
     x = rec.data[i]
     if not np.isfinite(x).all():

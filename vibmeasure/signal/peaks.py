@@ -16,7 +16,7 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.signal import find_peaks
 
-from ..core._validate import check_band
+from ..core._validate import check_band, name_index
 from ..core.errors import ParameterError
 from ..core.results import Peaks, Spectrum
 
@@ -78,9 +78,7 @@ def pick_peaks(spec: Spectrum, *, n: int | None = None, prominence: float | None
         raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
     if spec.kind in ("csd", "coherence"):
         raise ParameterError(f"peaks are picked on amplitude, power, PSD or envelope spectra, not {spec.kind!r}")
-    ch = spec.channels.index(channel) if isinstance(channel, str) and channel in spec.channels else channel
-    if not isinstance(ch, (int, np.integer)) or not 0 <= ch < spec.n_channels:
-        raise ParameterError(f"channel={channel!r} is not in this spectrum; channels are {list(spec.channels)}")
+    ch = name_index(spec.channels, channel)
     if n is not None and (isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1):
         raise ParameterError(f"n={n!r} must be None or an integer >= 1")
     vals = np.abs(spec.values[ch])
@@ -142,7 +140,9 @@ def harmonic_family(spec: Spectrum, f0: float | None = None, *, n_harmonics: int
     """
     if isinstance(n_harmonics, bool) or not isinstance(n_harmonics, (int, np.integer)) or n_harmonics < 1:
         raise ParameterError(f"n_harmonics={n_harmonics!r} must be an integer >= 1")
-    ch = spec.channels.index(channel) if isinstance(channel, str) else channel
+    if not isinstance(spec, Spectrum):
+        raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
+    ch = name_index(spec.channels, channel)
     vals = np.abs(spec.values[ch])
     floor = float(5 * np.median(vals[1:])) if floor is None else floor
 
@@ -191,7 +191,9 @@ def sideband_family(spec: Spectrum, carrier: float, spacing: float, *, n: int = 
     """
     if not (np.isfinite(carrier) and np.isfinite(spacing)) or carrier <= 0 or spacing <= 0:
         raise ParameterError(f"carrier={carrier!r} and spacing={spacing!r} must be > 0 Hz")
-    ch = spec.channels.index(channel) if isinstance(channel, str) else channel
+    if not isinstance(spec, Spectrum):
+        raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
+    ch = name_index(spec.channels, channel)
     vals = np.abs(spec.values[ch])
     floor = float(5 * np.median(vals[1:])) if floor is None else floor
     tol = max(1.5 * spec.df, spacing / 10)
