@@ -131,6 +131,15 @@ def _line_near(spec: Spectrum, ch: int, f: float, tol: float, floor: float):
     return spec.freq[0] + pos * spec.df, (m ** 2 if spec.kind in ("psd", "power") else m)
 
 
+def _channel_floor(spec, channel, floor):
+    """The channel's row and the level a family line must exceed (default 5x the median)."""
+    if not isinstance(spec, Spectrum):
+        raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
+    ch = name_index(spec.channels, channel)
+    vals = np.abs(spec.values[ch])
+    return ch, (float(5 * np.median(vals[1:])) if floor is None else floor)
+
+
 def harmonic_family(spec: Spectrum, f0: float | None = None, *, n_harmonics: int = 10, channel=0,
                     rtol: float = 2e-3, floor: float | None = None) -> dict:
     """Harmonics 1X, 2X, ... of a fundamental (given, or the one whose harmonics explain most of the
@@ -140,11 +149,7 @@ def harmonic_family(spec: Spectrum, f0: float | None = None, *, n_harmonics: int
     """
     if isinstance(n_harmonics, bool) or not isinstance(n_harmonics, (int, np.integer)) or n_harmonics < 1:
         raise ParameterError(f"n_harmonics={n_harmonics!r} must be an integer >= 1")
-    if not isinstance(spec, Spectrum):
-        raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
-    ch = name_index(spec.channels, channel)
-    vals = np.abs(spec.values[ch])
-    floor = float(5 * np.median(vals[1:])) if floor is None else floor
+    ch, floor = _channel_floor(spec, channel, floor)
 
     def fam(f):
         lines = []
@@ -191,11 +196,7 @@ def sideband_family(spec: Spectrum, carrier: float, spacing: float, *, n: int = 
     """
     if not (np.isfinite(carrier) and np.isfinite(spacing)) or carrier <= 0 or spacing <= 0:
         raise ParameterError(f"carrier={carrier!r} and spacing={spacing!r} must be > 0 Hz")
-    if not isinstance(spec, Spectrum):
-        raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
-    ch = name_index(spec.channels, channel)
-    vals = np.abs(spec.values[ch])
-    floor = float(5 * np.median(vals[1:])) if floor is None else floor
+    ch, floor = _channel_floor(spec, channel, floor)
     tol = max(1.5 * spec.df, spacing / 10)
     lines = []
     for k in range(-n, n + 1):

@@ -15,6 +15,7 @@ import numpy as np
 import scipy.fft as _fft
 from scipy import signal as _sig
 
+from ..core._validate import select_names
 from ..core.errors import ParameterError
 from ..core.record import Record
 from ..core.results import Spectrogram, Spectrum
@@ -49,22 +50,7 @@ def _source(rec, fs=None):
 
 
 def _channel_indices(src, channels) -> list[int]:
-    names = [c.name for c in src.channels]
-    if channels is None:
-        return list(range(src.n_channels))
-    if isinstance(channels, (str, int, np.integer)):
-        channels = [channels]
-    out = []
-    for c in channels:
-        if isinstance(c, (int, np.integer)) and not isinstance(c, bool):
-            if not 0 <= c < len(names):
-                raise ParameterError(f"channels={channels!r}: index {c} out of range for {len(names)} channels")
-            out.append(int(c))
-        elif c in names:
-            out.append(names.index(c))
-        else:
-            raise ParameterError(f"channels={channels!r}: {c!r} is not in this record; channels are {names}")
-    return out
+    return select_names([c.name for c in src.channels], channels, source="this record")
 
 
 def get_window(window, n: int) -> np.ndarray:
