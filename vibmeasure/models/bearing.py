@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -9,7 +10,7 @@ import numpy as np
 from ..core._validate import positive
 from ..core.errors import ParameterError
 
-__all__ = ["Bearing", "Gear", "BEARINGS"]
+__all__ = ["Bearing", "Gear", "BEARINGS", "bearing_from"]
 
 
 @dataclass(frozen=True)
@@ -58,8 +59,43 @@ class Gear:
             raise ParameterError(f"teeth={self.teeth!r} must be an integer >= 5")
 
 
-# SKF deep-groove bearings as used in the CWRU test rig (dimensions in inches)
-BEARINGS = {
-    "6205-2RS": Bearing(9, 0.3126, 1.537, 0.0, "SKF 6205-2RS JEM"),
-    "6203-2RS": Bearing(8, 0.2656, 1.122, 0.0, "SKF 6203-2RS JEM"),
-}
+def _load_catalogue() -> dict:
+    """The shipped catalogue (vibmeasure/data/bearings.csv): rig bearings with published geometry
+    and nominal 62xx/63xx deep-groove designs."""
+    import csv
+    from pathlib import Path
+    out = {}
+    with open(Path(__file__).resolve().parents[1] / "data" / "bearings.csv", newline="", encoding="utf-8") as fh:
+        rows = csv.DictReader(line for line in fh if not line.startswith("#"))
+        for r in rows:
+            desc = r["description"] + (" [nominal design: check the maker's datasheet]" if r["source"] == "nominal"
+                                       else "")
+            out[r["name"]] = Bearing(int(r["n"]), float(r["d"]), float(r["D"]), float(r["angle"]), desc)
+    return out
+
+
+BEARINGS = _load_catalogue()
+_SUFFIX = re.compile(r"[-\s]?(2RS1?|2RSH|2RZ|2Z|ZZ|RS|Z|N|NR|C3|C4|E|JEM|/C3)+$", re.I)
+
+
+def bearing_from(spec) -> Bearing | None:
+    """A vm.Bearing from a Bearing, None, or a catalogue name ("6205-2RS", "6308", "6308-2Z C3",
+    "MFPT"); seals, shields and clearance suffixes fall back to the base designation."""
+    if spec is None or isinstance(spec, Bearing):
+        return spec
+    if not isinstance(spec, str):
+        raise ParameterError(f"bearing must be a vm.Bearing or a catalogue name, got {type(spec).__name__}")
+    key = spec.strip().upper()
+    names = {k.upper(): k for k in BEARINGS}
+    if key in names:
+        return BEARINGS[names[key]]
+    base = key.replace(" ", "")
+    while True:
+        shorter = _SUFFIX.sub("", base)
+        if shorter == base:
+            break
+        base = shorter
+    if base in names:
+        return BEARINGS[names[base]]
+    raise ParameterError(f"bearing={spec!r} is not in the catalogue ({', '.join(sorted(BEARINGS))}); "
+                         "give vm.Bearing(n_balls, ball_diameter, pitch_diameter, contact_angle)")

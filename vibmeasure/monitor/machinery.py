@@ -1,6 +1,10 @@
-"""Machine fault diagnosis from one accelerometer record: fault-frequency catalogue, running-speed
-check, envelope analysis with a kurtosis-chosen band, evidence and confidence per fault family, and
-ISO 10816-3 severity. Weak evidence gives top = "none" with the reason, never a confident guess.
+"""Machine fault diagnosis from accelerometer records, read as its pipeline:
+
+prepare (channels, units, bearing, limits) -> spectrum -> running speed and its consistency with fs
+-> ISO 10816-3 severity -> shaft-order faults (unbalance, misalignment, looseness, resonance,
+electrical, gear mesh; gated by severity) -> bearing families (statistical test on pre-whitened
+squared-envelope spectra of every channel, never gated by severity: monitor/bearing_faults.py)
+-> decision. Weak evidence gives top = "none" with the reason and the strongest candidate.
 """
 
 from __future__ import annotations
@@ -9,10 +13,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core import units as _units
 from ..core._validate import as_record, clean_signal, positive, response_channel
 from ..core.errors import ParameterError
-from ..core import units as _units
-from ..models.bearing import BEARINGS, Bearing, Gear
+from ..models.bearing import Bearing, Gear, bearing_from
+from .bearing_faults import FAMILIES, bearing_evidence
 
 __all__ = ["diagnose", "Diagnosis", "ISO_10816_3", "severity_zone"]
 
@@ -24,7 +29,8 @@ ISO_10816_3 = {(1, "rigid"): (2.3, 4.5, 7.1), (1, "flexible"): (3.5, 7.1, 11.0),
 ISO_SCOPE_RPM = (120.0, 15000.0)
 LINE_DB = 12.0     # a line counts as present this far above its local floor (noise maxima reach ~10 dB)
 TOP_CONFIDENCE = 0.5
-SLIP = 0.02        # bearing frequencies wander with slip and load: +-2 %
+MAX_RPM = 120000.0
+SHAFT_FAULTS = ("unbalance", "misalignment", "looseness", "resonance", "electrical", "gear_mesh")
 
 
 def severity_zone(v_rms_mm_s: float, *, group: int = 2, foundation: str = "rigid") -> str:
@@ -39,8 +45,11 @@ def severity_zone(v_rms_mm_s: float, *, group: int = 2, foundation: str = "rigid
 @dataclass(frozen=True)
 class Diagnosis:
     """``top`` (none, unbalance, misalignment, looseness, bearing_outer_race, bearing_inner_race,
-    bearing_ball, bearing_cage, gear_mesh, resonance, electrical), its ``confidence`` and ``reason``; ``faults`` (table per
-    fault family), ``speed`` (estimated rpm and consistency), ``severity`` (ISO zone), ``flags``."""
+    bearing_ball, gear_mesh, resonance, electrical), its ``confidence`` and ``reason``; ``faults``
+    (table per fault family: evidence, p-value for bearing families, channel, pre-processing, band),
+    ``speed`` (estimated rpm and consistency), ``severity`` (ISO zone), ``channel`` (where the top's
+    evidence is), ``bearing_checked`` (False without a bearing), ``flags``; ``extras`` holds the bearing
+    test per family, the winning squared-envelope spectrum and the kurtogram (for plots)."""
 
     top: str
     confidence: float
@@ -51,16 +60,37 @@ class Diagnosis:
     envelope_band_hz: tuple
     flags: tuple = ()
     extras: dict = field(default_factory=dict)
+    channel: str = ""
+    bearing_checked: bool = False
 
     def to_dict(self) -> dict:
         from ..core.results import _jsonable
         return _jsonable({"top": self.top, "confidence": self.confidence, "reason": self.reason,
+                          "channel": self.channel, "bearing_checked": self.bearing_checked,
                           "faults": self.faults.to_dict(orient="records"), "speed": self.speed,
                           "severity": self.severity, "envelope_band_hz": list(self.envelope_band_hz),
-                          "flags": list(self.flags)})
+                          "flags": list(self.flags), "also": list(self.extras.get("also", ()))})
 
     def __repr__(self) -> str:
         return f"Diagnosis(top={self.top!r}, confidence={self.confidence:.2f}: {self.reason})"
+
+
+@dataclass
+class _Job:
+    """What diagnose works on, checked: the primary channel (speed, severity, shaft orders), the
+    channels searched for bearing faults, and the machine's description."""
+    fs: float
+    rpm: float
+    primary: str
+    a: np.ndarray
+    signals: dict
+    bearing: Bearing | None
+    gear: Gear | None
+    group: int
+    foundation: str
+    band: tuple | None
+    flags: list
+    prewhitening: tuple = ("cepstral",)
 
 
 def _line(freq, values, f, tol, floor_halfwidth):
@@ -74,274 +104,291 @@ def _line(freq, values, f, tol, floor_halfwidth):
     return float(freq[k]), float(values[k]), float(20 * np.log10(values[k] / max(floor, 1e-300)))
 
 
-def _kurtogram_band(x, fs, f_lo):
-    """The band (among 1/1 and 1/3-octave-wide bands above f_lo) whose envelope is most impulsive."""
-    from scipy import signal as sg
-    best, best_k = None, -np.inf
-    nyq = fs / 2
-    for width in (0.7, 0.35):  # relative bandwidths
-        fc = f_lo * 1.3
-        while fc * (1 + width / 2) < 0.95 * nyq:
-            lo, hi = fc * (1 - width / 2), fc * (1 + width / 2)
-            sos = sg.butter(4, (lo, hi), btype="bandpass", fs=fs, output="sos")
-            env = np.abs(sg.hilbert(sg.sosfiltfilt(sos, x)))
-            e = env - env.mean()
-            k = float(np.mean(e ** 4) / np.mean(e ** 2) ** 2 - 2)  # kurtosis of a complex envelope: 0 for noise
-            if k > best_k:
-                best, best_k = (lo, hi), k
-            fc *= 1 + width / 2
-    return best, best_k
+# --- prepare ---------------------------------------------------------------------------------------
+
+def _accel(rec, i, flags):
+    """Channel i as float64, in m/s^2 when its unit is a known acceleration unit."""
+    x = clean_signal(rec, i, min_samples=256)
+    ch = rec.channels[i]
+    if ch.unit and ch.quantity == "acceleration":
+        x = _units.convert(x, ch.unit, "m/s^2")
+    elif "unit_unknown" not in flags:
+        flags.append("unit_unknown")
+    peak = float(np.max(np.abs(x)))
+    if not 1e-200 < peak < 1e200:
+        raise ParameterError(f"channel {ch.name!r} peaks at {peak:g}: outside the range 1e-200..1e200 that the "
+                             "spectra can represent; rescale the record (check its unit)")
+    return x
 
 
-def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_group: int | None = None,
-             foundation: str | None = None, channel=None, band=None, line_frequency: float | None = None,
-             fs: float | None = None):
-    """Diagnose a rotating machine from an acceleration record.
-
-    ``rpm`` is the declared shaft speed (default: the record's meta["rpm"]); ``bearing`` a
-    vm.Bearing or a catalogue name ("6205-2RS", "6203-2RS"); ``gear`` a tooth count or vm.Gear;
-    ``machine_group`` (1 or 2) and ``foundation`` ("rigid", "flexible") select the ISO 10816-3
-    zones (default group 2, rigid). ``band`` fixes the envelope band (default: most impulsive band).
-    ``line_frequency`` (50 or 60 Hz) adds the electrical check at twice the line frequency.
-    """
-    rec = as_record(rec, fs=fs)
+def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band) -> _Job:
     idx = response_channel(rec, channel)
-    x = clean_signal(rec, idx, min_samples=256)
-    ch = rec.channels[idx]
     if rpm is None:
         rpm = rec.meta.get("rpm")
         if rpm is None:
             raise ParameterError("rpm is required (the declared shaft speed), e.g. diagnose(rec, rpm=1797)")
     rpm = positive(rpm, "rpm")
+    if rpm > MAX_RPM:
+        raise ParameterError(f"rpm={rpm:g} exceeds {MAX_RPM:g} rpm: no rotating machine this tool covers runs that fast")
     f1 = rpm / 60.0
-    fsr = rec.fs
-    T = x.size / fsr
+    T = rec.n_samples / rec.fs
     if T * f1 < 20:
         raise ParameterError(f"the record spans {T * f1:.1f} shaft revolutions ({T:.3g} s at {rpm:g} rpm); at least "
                              f"20 are needed for the order resolution (record {20 / f1:.3g} s or more)")
-    if isinstance(bearing, str):
-        if bearing not in BEARINGS:
-            raise ParameterError(f"bearing={bearing!r} is not in the catalogue {sorted(BEARINGS)}; give a vm.Bearing")
-        bearing = BEARINGS[bearing]
-    if bearing is not None and not isinstance(bearing, Bearing):
-        raise ParameterError(f"bearing must be a vm.Bearing or a catalogue name, got {type(bearing).__name__}")
-    if gear is not None and not isinstance(gear, Gear):
-        gear = Gear(int(gear))
     group = 2 if machine_group is None else machine_group
     found = "rigid" if foundation is None else foundation
     if (group, found) not in ISO_10816_3:
         raise ParameterError(f"machine_group={machine_group!r}, foundation={foundation!r}: group 1 or 2, "
                              "foundation 'rigid' or 'flexible'")
-    bf = bearing.frequencies(f1) if bearing is not None else {}
-    for name, f in bf.items():
-        if name != "FTF" and 3 * f >= fsr / 2:
-            raise ParameterError(f"fs={fsr:g} Hz is too low for the bearing lines: the third harmonic of {name} "
-                                 f"({3 * f:.1f} Hz) lies above the Nyquist frequency {fsr / 2:g} Hz")
-    if gear is not None and (gear.teeth + 2) * f1 >= fsr / 2:
-        raise ParameterError(f"fs={fsr:g} Hz is too low for the gear mesh ({gear.teeth * f1:.1f} Hz) and its sidebands")
-    # acceleration in m/s^2 when the unit is known
-    a = _units.convert(x, ch.unit, "m/s^2") if ch.unit and ch.quantity == "acceleration" else x
-    flags = []
-    if not (ch.unit and ch.quantity == "acceleration"):
-        flags.append("unit_unknown")
+    bearing = bearing_from(bearing)
+    if gear is not None and not isinstance(gear, Gear):
+        gear = Gear(gear)
+    _check_nyquist(rec.fs, f1, bearing, gear)
+    flags: list = []
+    a = _accel(rec, idx, flags)
+    if channels is None:
+        chosen = [i for i, c in enumerate(rec.channels) if c.quantity not in ("force", "time")]
+    else:
+        chosen = [rec.index(c) for c in ([channels] if isinstance(channels, (str, int)) else channels)]
+    if idx not in chosen:
+        chosen.insert(0, idx)
+    signals = {rec.channels[i].name: (a if i == idx else _accel(rec, i, flags)) for i in chosen}
+    if band is not None:
+        from ..core._validate import check_band
+        band = check_band(band, rec.fs)
+    return _Job(rec.fs, rpm, rec.channels[idx].name, a, signals, bearing, gear, group, found, band, flags)
 
-    # --- spectra ------------------------------------------------------------------------------
-    n = x.size
+
+def _check_prewhitening(value) -> tuple:
+    from .bearing_faults import WHITENING
+    items = (value,) if isinstance(value, str) else tuple(value) if isinstance(value, (list, tuple)) else None
+    if not items or any(v not in WHITENING for v in items):
+        raise ParameterError(f"prewhitening={value!r} must name one or more of {WHITENING}")
+    return items
+
+
+def _check_nyquist(fs, f1, bearing, gear):
+    if bearing is not None:
+        for name, f in bearing.frequencies(f1).items():
+            if name != "FTF" and 3 * f >= fs / 2:
+                raise ParameterError(f"fs={fs:g} Hz is too low for the bearing lines: the third harmonic of {name} "
+                                     f"({3 * f:.1f} Hz) lies above the Nyquist frequency {fs / 2:g} Hz")
+    if gear is not None and (gear.teeth + 2) * f1 >= fs / 2:
+        raise ParameterError(f"fs={fs:g} Hz is too low for the gear mesh ({gear.teeth * f1:.1f} Hz) and its sidebands")
+
+
+# --- spectrum, speed, severity -------------------------------------------------------------------------
+
+def _spectrum(job: _Job):
+    """Hann amplitude spectrum of the primary channel (acceleration) and the velocity spectrum from it."""
+    n = job.a.size
     win = np.hanning(n)
-    A = np.abs(np.fft.rfft((a - a.mean()) * win)) * 2 / win.sum()
-    f = np.fft.rfftfreq(n, 1 / fsr)
-    df = f[1]
-    with np.errstate(divide="ignore"):
-        V = np.where(f > 0, A / (2 * np.pi * np.maximum(f, 1e-12)), 0.0)  # velocity amplitude, m/s
-    tol1 = max(2.5 * df, 0.01 * f1)
+    A = np.abs(np.fft.rfft((job.a - job.a.mean()) * win)) * 2 / win.sum()
+    f = np.fft.rfftfreq(n, 1 / job.fs)
+    V = np.where(f > 0, A / (2 * np.pi * np.maximum(f, 1e-12)), 0.0)  # velocity amplitude
+    return f, A, V
 
-    # --- running speed and its consistency with fs --------------------------------------------
-    f1_found, _, snr1 = _line(f, A, f1, max(0.03 * f1, 2 * df), 10 * f1 * 0.1 + 5 * df)
-    speed = {"declared_rpm": rpm, "estimated_rpm": 60 * f1_found if snr1 >= LINE_DB else None,
-             "one_x_db": snr1, "consistent": True, "note": ""}
+
+def _speed(job: _Job, f, A):
+    """Running speed from the 1X line near the declared rpm; a 1X that only fits another fs is flagged."""
+    df = f[1]
+    f1 = job.rpm / 60.0
+    f1_found, _, snr1 = _line(f, A, f1, max(0.03 * f1, 2 * df), f1 + 5 * df)
+    speed = {"declared_rpm": job.rpm, "estimated_rpm": 60 * f1_found if snr1 >= LINE_DB else None,
+             "one_x_db": snr1, "consistent": True, "note": "", "fs_ratio": 1}
     if snr1 >= LINE_DB:
-        f1 = f1_found
-    # a 1X that only fits if the real sampling rate is r times the declared one shows at f1 / r
+        f1 = _refine(f, A, f1_found)
+        speed["estimated_rpm"] = 60 * f1
     for r in (4, 2):
         hits = [_line(f, A, k * f1 / r, max(2 * df, 0.01 * k * f1 / r), 0.5 * f1 / r)[2] >= LINE_DB
                 for k in range(1, 2 * r) if k % r]
         if r == 4 and sum(hits) >= 3 or r == 2 and all(hits) and snr1 < LINE_DB:
-            speed.update(consistent=False, note=(
-                f"lines at {1 / r:g}X, ... fit a shaft speed of {rpm:g} rpm only if fs is {r}x the declared "
-                f"{fsr:g} Hz ({r * fsr:g} Hz): check the sampling rate"))
-            flags.append("speed_inconsistent")
+            speed.update(consistent=False, fs_ratio=r, note=(
+                f"lines at {1 / r:g}X, ... fit a shaft speed of {job.rpm:g} rpm only if fs is {r}x the declared "
+                f"{job.fs:g} Hz ({r * job.fs:g} Hz): check the sampling rate"))
+            job.flags.append("speed_inconsistent")
             break
-    if bearing is not None:
-        bf = bearing.frequencies(f1)  # at the estimated running speed
     if speed["consistent"] and snr1 < LINE_DB:
-        speed["note"] = f"no 1X line within 3 % of the declared {rpm:g} rpm"
+        speed["note"] = f"no 1X line within 3 % of the declared {job.rpm:g} rpm"
+    return speed, f1
 
-    # --- severity (ISO 10816-3) -----------------------------------------------------------------
+
+def _refine(f, A, f0):
+    """Sub-bin frequency of the line at f0 (parabola through the log amplitudes of the Hann peak)."""
+    k = int(round(f0 / f[1]))
+    if not 1 <= k < A.size - 1:
+        return f0
+    a, b, c = np.log(np.maximum(A[k - 1: k + 2], 1e-300))
+    den = a - 2 * b + c
+    return float(f0 + (0.5 * (a - c) / den if den < 0 else 0.0) * f[1])
+
+
+def _severity(job: _Job, f, rpm):
     lo = 2.0 if rpm < 600 else 10.0
     sel = (f >= lo) & (f <= 1000.0)
-    v_rms = float(np.sqrt(np.sum(np.abs(np.fft.rfft(a - a.mean())[sel] / (2 * np.pi * f[sel])) ** 2) * 2) / n) \
-        * 1e3 if sel.any() else np.nan
+    n = job.a.size
+    v_rms = float(np.sqrt(np.sum(np.abs(np.fft.rfft(job.a - job.a.mean())[sel] / (2 * np.pi * f[sel])) ** 2) * 2)
+                  / n) * 1e3 if sel.any() else np.nan
+    known = "unit_unknown" not in job.flags
     in_scope = ISO_SCOPE_RPM[0] <= rpm <= ISO_SCOPE_RPM[1]
-    severity = {"velocity_rms_mm_s": v_rms if "unit_unknown" not in flags else None, "band_hz": [lo, 1000.0],
-                "group": group, "foundation": found,
-                "zone": severity_zone(v_rms, group=group, foundation=found) if "unit_unknown" not in flags else None,
-                "in_scope": in_scope,
+    severity = {"velocity_rms_mm_s": v_rms if known else None, "band_hz": [lo, 1000.0], "group": job.group,
+                "foundation": job.foundation, "zone": severity_zone(v_rms, group=job.group, foundation=job.foundation)
+                if known else None, "in_scope": in_scope,
                 "note": "" if in_scope else f"{rpm:g} rpm is outside ISO 10816-3's 120-15000 rpm: zone is indicative"}
-    ab = ISO_10816_3[(group, found)][0]
+    ab = ISO_10816_3[(job.group, job.foundation)][0]
     # shaft-order faults must matter: nothing below half the zone A/B boundary, full weight from it on
-    level = float(np.clip((v_rms - 0.5 * ab) / (0.5 * ab), 0, 1)) if np.isfinite(v_rms) else 1.0
+    level = float(np.clip((v_rms - 0.5 * ab) / (0.5 * ab), 0, 1)) if np.isfinite(v_rms) and known else 1.0
+    return severity, level
 
+
+def _row(fault, expected, found_hz, amp, db, conf, note="", **more):
+    return {"fault": fault, "expected_hz": expected, "found_hz": found_hz, "amplitude": amp, "evidence_db": db,
+            "confidence": float(np.clip(conf, 0, 1)), "note": note, **more}
+
+
+# --- bearings ---------------------------------------------------------------------------------------
+
+def _bearing_rows(job: _Job, f1: float, speed: dict):
+    """One row per bearing family from the statistical test over every channel; the evidence."""
+    if job.bearing is None:
+        return [], None
+    freqs = job.bearing.frequencies(f1)
+    shaft = f1 / speed.get("fs_ratio", 1)
+    ev = bearing_evidence(job.signals, job.fs, f1, freqs, job.bearing.n_balls, band=job.band,
+                          shaft_hz=shaft, f1_known=speed["estimated_rpm"] is not None, whitening=job.prewhitening)
     rows = []
-
-    def add(fault, expected, found_hz, amp, db, conf, note=""):
-        rows.append({"fault": fault, "expected_hz": expected, "found_hz": found_hz, "amplitude": amp,
-                     "evidence_db": db, "confidence": float(np.clip(conf, 0, 1)), "note": note})
-
-    # --- shaft orders (velocity) -----------------------------------------------------------------
-    order = {}
-    for k in (0.5, 1, 1.5, 2, 2.5, 3, 4, 5, 6, 7, 8, 9, 10):
-        fk = k * f1
-        if fk < f[-1]:
-            order[k] = _line(f, V, fk, max(tol1, 2 * df), max(0.4 * f1, 10 * df))
-    v1 = order[1][1] if order.get(1) and order[1][1] is not None else 0.0
-    v2 = order[2][1] if order.get(2) and order[2][1] is not None else 0.0
-    v1_rms_mm = v1 / np.sqrt(2) * 1e3
-    frac1 = (v1_rms_mm / v_rms) ** 2 if v_rms > 0 else 0.0
-    add("unbalance", f1, order[1][0], v1, order[1][2],
-        level * np.clip((frac1 - 0.5) / 0.3, 0, 1) * (v2 < 0.5 * v1) * (order[1][2] >= LINE_DB),
-        f"1X carries {frac1 * 100:.0f} % of the velocity power")
-    ratio = v2 / v1 if v1 > 0 else np.inf
-    add("misalignment", 2 * f1, order[2][0], v2, order[2][2],
-        level * np.clip((ratio - 0.5) / 0.5, 0, 1) * (order[2][2] >= LINE_DB), f"2X/1X = {ratio:.2f}")
-    harmonics = [k for k in (3, 4, 5, 6, 7, 8, 9, 10) if k in order and order[k][2] >= LINE_DB
-                 and order[k][1] > 0.1 * max(v1, 1e-300)]
-    subs = [k for k in (0.5, 1.5, 2.5) if k in order and order[k][2] >= LINE_DB]
-    loose = np.clip((len(harmonics) - 2) / 4 + 0.35 * len(subs), 0, 1) * level
-    if "speed_inconsistent" in flags:
-        loose *= 0.3  # the sub-harmonics are explained by the sampling-rate contradiction
-    add("looseness", f1, None, None, float(len(harmonics)), loose,
-        f"{len(harmonics)} harmonics above 2X, sub-harmonics at {subs or 'none'}")
-
-    # --- resonance: the noise floor raised into a hump around a shaft order ---------------------------
-    res_conf, res_f, res_db = 0.0, None, 0.0
-    for k in (1, 2, 3, 4):
-        if k not in order or order[k][2] < LINE_DB:
-            continue
-        fk = k * f1
-        half = max(3.0, 0.1 * fk)
-        local = (np.abs(f - fk) <= half) & (np.abs(f - fk) > 4 * df)      # beside the tone, inside a hump
-        far = (f > 0.3 * fk) & (f < 3 * fk) & (np.abs(f - fk) > 0.3 * fk)   # the floor away from it
-        for j in order:                                                    # other order lines are not floor
-            far &= np.abs(f - j * f1) > 4 * df
-        if local.sum() < 8 or far.sum() < 8:
-            continue
-        db = float(20 * np.log10(np.median(V[local]) / max(np.median(V[far]), 1e-300)))
-        if db > res_db:
-            res_db, res_f = db, float(fk)
-    if res_f is not None:
-        res_conf = level * float(np.clip((res_db - 10) / 6, 0, 1))
-        # an order amplified by a mode next to it is the resonance's doing, not unbalance/misalignment
-        for r in rows:
-            if (r["fault"] == "unbalance" and abs(res_f - f1) < 0.5 * f1) or \
-                    (r["fault"] == "misalignment" and abs(res_f - 2 * f1) < 0.5 * f1):
-                r["confidence"] = float(r["confidence"] * (1 - res_conf))
-                r["note"] += f"; the order sits on a resonance (hump {res_db:.1f} dB)" if res_conf > 0 else ""
-    add("resonance", res_f, res_f, None, res_db, res_conf,
-        f"noise floor raised {res_db:.1f} dB around the order at {res_f or 0:.1f} Hz (a structural mode there)")
-
-    # --- twice line frequency (electrical) -------------------------------------------------------------
-    if line_frequency is not None:
-        lf = positive(line_frequency, "line_frequency")
-        fo, am, db = _line(f, A, 2 * lf, max(2.5 * df, 0.002 * lf), max(5.0, 10 * df))
-        add("electrical", 2 * lf, fo, am, db, level * float(np.clip((db - LINE_DB) / 12, 0, 1)) *
-            (abs(2 * lf - round(2 * lf / f1) * f1) > max(3 * df, 0.01 * f1)),  # not a shaft order in disguise
-            f"2 x line frequency ({2 * lf:g} Hz) line {db:.1f} dB")
-
-    # --- bearings (squared-envelope spectrum) -----------------------------------------------------
-    env_band = ()
-    if bearing is not None:
-        from ..signal.demod import envelope_spectrum
-        from ..core.record import Record
-        f_lo = max(10 * bf["BPFI"], 500.0)
-        if band is None:
-            b_sel, kurt = _kurtogram_band(a, fsr, f_lo)
-            if b_sel is None:
-                raise ParameterError(f"fs={fsr:g} Hz leaves no demodulation band above {f_lo:.0f} Hz")
-            env_band = b_sel
+    for name, s in ev["families"].items():
+        lines = [f"{ln['hz']:.1f} Hz {ln['db']:.0f} dB" for ln in s["lines"] if ln["r"] >= 6.0]
+        if name == "bearing_cage":
+            note = ("cage-rate modulation (FTF comb): common on healthy bearings; not a fault by itself, trend it"
+                    if s["found"] else "no cage-rate comb")
+        elif s["p_value"] < 1.0:
+            note = (f"{s['model']} at slip {s['slip'] * 100:+.2f} %: {len(lines)} line(s) above the floor "
+                    f"({', '.join(lines[:4])}); p = {s['p_value']:.2g} over {ev['n_spectra']} spectra; "
+                    f"{s['preprocessing']} {s['band_hz'][0]:.0f}-{s['band_hz'][1]:.0f} Hz in {s['channel']!r}; "
+                    f"claimed first in {s['votes']} spectra")
         else:
-            env_band = tuple(band)
-        # the fault must show in the most impulsive band and in a broad high band alike
-        broad = (max(f_lo, 0.15 * fsr / 2), 0.9 * fsr / 2)
-        spectra = [envelope_spectrum(Record(a, fsr), band=b_) for b_ in (env_band, broad)]
+            note = "no comb in any envelope spectrum"
+        rows.append(_row(name, s["expected_hz"], s["found_hz"], s["amplitude"], s["evidence_db"], s["confidence"],
+                         note, p_value=s["p_value"], log10_p=s["log10_p"], slip=s["slip"], channel=s["channel"],
+                         preprocessing=s["preprocessing"], band_hz=s["band_hz"], votes=s["votes"],
+                         harmonics=[{k: ln[k] for k in ("harmonic", "sideband", "hz", "db")} for ln in s["lines"]]))
+    return rows, ev
 
-        def fam(es, ff, ks=(1, 2, 3)):
-            ef, ev = es.freq, es.values[0]
-            edf = ef[1]
-            ev_sum, best, harm = 0.0, (None, None, -np.inf), 0
-            for k in ks:
-                fk = k * ff
-                fo, am, db = _line(ef, ev, fk, max(2.5 * edf, SLIP * fk), max(0.25 * ff, 10 * edf))
-                w = 1.0 if k == 1 else 0.5
-                # a line sitting on a shaft harmonic is weaker evidence
-                if min(abs(fk - m * f1) for m in range(1, int(fk / f1) + 2)) < max(2.5 * edf, SLIP * fk):
-                    w *= 0.3
-                ev_sum += w * max(0.0, db - LINE_DB) / 6
-                harm += k > 1 and db >= LINE_DB
-                if k == 1:
-                    best = (fo, am, db)
-            return ev_sum, best, harm
 
-        bearing_rows = []
-        for fault, key, extra in (("bearing_outer_race", "BPFO", None), ("bearing_inner_race", "BPFI", "1X"),
-                                  ("bearing_ball", "2xBSF", "FTF"), ("bearing_cage", "FTF", None)):
-            evid, first, harms = [], None, []
-            for es in spectra:
-                e, b1, h = fam(es, bf[key])
-                if fault == "bearing_ball":
-                    e2, _, h2 = fam(es, bf["BSF"], (1, 3))
-                    e, h = max(e, e2), max(h, h2)
-                if extra:
-                    side = f1 if extra == "1X" else bf["FTF"]
-                    for sgn in (-1, 1):
-                        _, _, sdb = _line(es.freq, es.values[0], bf[key] + sgn * side,
-                                          max(2.5 * es.freq[1], SLIP * bf[key]), max(side, 10 * es.freq[1]))
-                        e += 0.5 * max(0.0, sdb - LINE_DB) / 6
-                evid.append(e)
-                harms.append(h)
-                first = first or b1
-            e = min(evid)
-            bearing_rows.append([fault, bf[key], first, e, min(harms)])
-        for fault, fk, (fo, am, db), e, h in bearing_rows:
-            # the strongest other family; a ball fault's cage (FTF) modulation is its own signature
-            others = [r[3] for r in bearing_rows if r[0] != fault and not (fault == "bearing_ball"
-                                                                           and r[0] == "bearing_cage")]
-            second = max(others) if others else 0.0
-            dominance = max(0.0, 1 - second / e) if e > 0 else 0.0
-            conf = (1 - np.exp(-e / 2)) * dominance * (1.0 if h >= 1 else 0.4)  # harmonics make a fault
-            add(fault, fk, fo, am, db, conf, f"{fault.split('_', 1)[1]} family (evidence {e:.2f}, {h} harmonic(s)) "
-                f"in the envelope of {env_band[0]:.0f}-{env_band[1]:.0f} Hz and of {broad[0]:.0f}-{broad[1]:.0f} Hz")
+# --- decision ---------------------------------------------------------------------------------------
 
-    # --- gear mesh ------------------------------------------------------------------------------------
-    if gear is not None:
-        fm = gear.teeth * f1
-        fo, am, db = _line(f, A, fm, max(2.5 * df, 0.005 * fm), max(2 * f1, 10 * df))
-        sb = [_line(f, A, fm + s * f1, max(2.5 * df, 0.005 * fm), max(f1, 10 * df))[2] for s in (-1, 1)]
-        e = max(0.0, db - LINE_DB) / 6 + sum(0.5 * max(0.0, s - LINE_DB) / 6 for s in sb)
-        add("gear_mesh", fm, fo, am, db, (1 - np.exp(-e / 2)) * (sum(s >= LINE_DB for s in sb) >= 1),
-            f"mesh {gear.teeth} x 1X with sidebands at +-1X ({sum(s >= LINE_DB for s in sb)} found)")
+def _decide(table, job: _Job, ev):
+    """The top fault: the most confident shaft-order or bearing fault at TOP_CONFIDENCE or more and not
+    tied with another of its own kind; else "none" with the reason and the strongest candidate."""
+    ranked = table.assign(_bearing=table.fault.isin(list(FAMILIES)))
+    # a bearing family that passed its test outranks shaft-order scores: it is the specific finding
+    ranked = ranked.sort_values(["_bearing", "confidence"], ascending=False)
+    calls = ranked[(ranked.confidence >= TOP_CONFIDENCE) & (ranked.fault != "bearing_cage")]
+    ranked = ranked.sort_values("confidence", ascending=False)
+    checked = "" if job.bearing is not None else "; bearing faults not checked (no bearing given)"
+    if len(calls):
+        best = calls.iloc[0]
+        kin = [r for _, r in calls.iloc[1:].iterrows() if (r.fault in FAMILIES) == (best.fault in FAMILIES)]
+        if not kin or best.confidence - kin[0].confidence >= 0.15:
+            top, conf = str(best.fault), float(best.confidence)
+            also = [str(r.fault) for _, r in calls.iloc[1:].iterrows() if r.fault != top]
+            reason = f"{top}: {best.note} (confidence {conf:.2f})"
+            if also:
+                reason += f"; also above {TOP_CONFIDENCE}: {', '.join(also)}"
+            channel = best.get("channel") if top in FAMILIES else job.primary
+            return top, conf, reason + checked, also, channel or job.primary
+        why = f"{best.fault} and {kin[0].fault} are equally likely"
+    else:
+        why = "no fault family stands out"
+    cand = ranked[ranked.fault != "bearing_cage"].iloc[0]
+    bear = table[table.fault.isin(list(FAMILIES))]
+    strongest = ""
+    if len(bear):
+        b = bear.sort_values("log10_p").iloc[0]
+        strongest = f"; strongest bearing candidate {b.fault} p = {b.p_value:.2g}"
+    p_none = _p_none(table)
+    reason = (f"none: {why}; strongest candidate {cand.fault} at confidence {cand.confidence:.2f}"
+              f"{strongest}{checked}")
+    return "none", p_none, reason, [], job.primary
 
+
+def _p_none(table) -> float:
+    """Probability that none of the families is present: the shaft-order confidences and the bearing
+    families' posterior odds (from their p-values) taken as independent."""
+    from .bearing_faults import _log_p_to_conf
+    shaft = table[table.fault.isin(SHAFT_FAULTS)].confidence.to_numpy()
+    p = float(np.prod(1 - shaft)) if shaft.size else 1.0
+    bear = table[table.fault.isin(list(FAMILIES))]
+    if len(bear):
+        c = _log_p_to_conf(bear.log10_p.to_numpy(float) * np.log(10))
+        p *= float(np.prod(1 - c))
+    return p
+
+
+def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_group: int | None = None,
+             foundation: str | None = None, channel=None, channels=None, band=None,
+             prewhitening=("cepstral",), line_frequency: float | None = None,
+             fs: float | None = None) -> Diagnosis:
+    """Diagnose a rotating machine from an acceleration record.
+
+    ``rpm`` is the declared shaft speed (default: the record's meta["rpm"]); ``bearing`` a vm.Bearing
+    or a catalogue name (``vm.BEARINGS``: "6205-2RS", "6203", "NU205", ...); ``gear`` a tooth count
+    or vm.Gear; ``machine_group`` (1 or 2) and ``foundation`` ("rigid", "flexible") select the ISO
+    10816-3 zones (default group 2, rigid). ``channel`` is the channel for speed, severity and shaft
+    orders (default the first that is not a force); bearing faults are searched in every channel
+    (``channels=`` restricts them) and the result names the one carrying the evidence. ``band`` fixes
+    the demodulation band (default: whole band, fast kurtogram and infogram bands); ``prewhitening``
+    names the pre-processings searched: "cepstral" (default) and/or "ar" (shaft-synchronous part and
+    discrete lines removed, then AR whitening). ``line_frequency``
+    (50 or 60 Hz) adds the electrical check at twice the line frequency.
+    """
+    from . import shaft_faults as sf
+    rec = as_record(rec, fs=fs)
+    job = _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band)
+    job.prewhitening = _check_prewhitening(prewhitening)
+    f, A, V = _spectrum(job)
+    speed, f1 = _speed(job, f, A)
+    severity, level = _severity(job, f, job.rpm)
+    v_rms = severity["velocity_rms_mm_s"] if severity["velocity_rms_mm_s"] is not None else np.nan
+    rows, order = sf.shaft_order_rows(f, V, f1, v_rms, level, job.flags, _line, _row, LINE_DB)
+    rows.append(sf.resonance_row(f, V, f1, order, level, rows, _row, LINE_DB))
+    if line_frequency is not None:
+        rows.append(sf.electrical_row(f, A, f1, line_frequency, level, _line, _row, LINE_DB))
+    b_rows, ev = _bearing_rows(job, f1, speed)
+    rows += b_rows
+    if job.gear is not None:
+        rows.append(sf.gear_row(f, A, f1, job.gear, _line, _row, LINE_DB))
     import pandas as pd
     table = pd.DataFrame(rows).sort_values("confidence", ascending=False, ignore_index=True)
-    best = table.iloc[0]
-    second = float(table.iloc[1]["confidence"]) if len(table) > 1 else 0.0
-    if best["confidence"] >= TOP_CONFIDENCE and best["confidence"] - second >= 0.15:
-        top, conf = str(best["fault"]), float(best["confidence"])
-        reason = f"{top}: {best['note']} (confidence {conf:.2f})"
-    else:
-        top, conf = "none", float(1 - best["confidence"])
-        why = "no fault family stands out" if best["confidence"] < TOP_CONFIDENCE else \
-            f"{best['fault']} and {table.iloc[1]['fault']} are equally likely"
-        reason = f"none: {why}; strongest candidate {best['fault']} at confidence {best['confidence']:.2f}"
-    if "speed_inconsistent" in flags:
+    top, conf, reason, also, where = _decide(table, job, ev)
+    if "speed_inconsistent" in job.flags:
         reason += "; " + speed["note"]
-    return Diagnosis(top, conf, reason, table, speed, severity, tuple(env_band), tuple(flags))
+    if job.bearing is None:
+        job.flags.append("bearing_not_checked")
+    extras = {"also": also}
+    env_band = ()
+    if ev is not None:
+        extras.update(_plot_material(ev, top))
+        env_band = extras["ses"]["band_hz"]
+    return Diagnosis(top, conf, reason, table, speed, severity, tuple(env_band), tuple(job.flags), extras,
+                     channel=str(where), bearing_checked=job.bearing is not None)
+
+
+def _plot_material(ev, top):
+    """The squared-envelope spectrum that carries the top (or strongest) bearing family, with its
+    kurtogram, for plot_diagnosis."""
+    fams = ev["families"]
+    name = top if top in FAMILIES else min(FAMILIES, key=lambda n: fams[n]["log_p"])
+    s = fams[name]
+    pick = ev["spectra"][0]
+    for sp in ev["spectra"]:
+        if sp.channel == s["channel"] and sp.prep == s["preprocessing"] and sp.band == s["band_hz"]:
+            pick = sp
+            break
+    kg = next((sp.kurtogram for sp in ev["spectra"] if sp.channel == pick.channel and sp.kurtogram is not None),
+              None)
+    ses = {"freq": pick.freq, "amp": pick.amp, "channel": pick.channel, "preprocessing": pick.prep,
+           "band_hz": pick.band, "family": name, "slip": s["slip"], "lines": s["lines"]}
+    return {"bearing": {k: {kk: vv for kk, vv in v.items() if kk != "lines"} for k, v in fams.items()},
+            "ses": ses, "kurtogram": kg}

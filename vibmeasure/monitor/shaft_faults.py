@@ -1,0 +1,96 @@
+"""Shaft-order faults from the velocity and acceleration spectra: unbalance, misalignment,
+looseness, resonance, twice line frequency (electrical) and gear mesh. Each returns table rows with
+a confidence scaled by ``level`` (0 below half the ISO zone A/B boundary, 1 from it on): a shaft-order
+fault must matter in the overall level before it is called."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core._validate import positive
+
+__all__ = ["shaft_order_rows", "resonance_row", "electrical_row", "gear_row"]
+
+ORDERS = (0.5, 1, 1.5, 2, 2.5, 3, 4, 5, 6, 7, 8, 9, 10)
+
+
+def _orders(f, V, f1, line):
+    df = f[1]
+    tol1 = max(2.5 * df, 0.01 * f1)
+    return {k: line(f, V, k * f1, max(tol1, 2 * df), max(0.4 * f1, 10 * df)) for k in ORDERS if k * f1 < f[-1]}
+
+
+def shaft_order_rows(f, V, f1, v_rms, level, flags, line, row, line_db):
+    """Unbalance (1X dominates the velocity), misalignment (2X against 1X), looseness (many
+    harmonics and half orders). Returns (rows, orders)."""
+    order = _orders(f, V, f1, line)
+    v1 = order[1][1] if order.get(1) and order[1][1] is not None else 0.0
+    v2 = order[2][1] if order.get(2) and order[2][1] is not None else 0.0
+    v1_rms_mm = v1 / np.sqrt(2) * 1e3
+    frac1 = (v1_rms_mm / v_rms) ** 2 if v_rms > 0 else 0.0
+    rows = [row("unbalance", f1, order[1][0], v1, order[1][2],
+                level * np.clip((frac1 - 0.5) / 0.3, 0, 1) * (v2 < 0.5 * v1) * (order[1][2] >= line_db),
+                f"1X carries {frac1 * 100:.0f} % of the velocity power")]
+    ratio = v2 / v1 if v1 > 0 else np.inf
+    rows.append(row("misalignment", 2 * f1, order[2][0], v2, order[2][2],
+                    level * np.clip((ratio - 0.5) / 0.5, 0, 1) * (order[2][2] >= line_db), f"2X/1X = {ratio:.2f}"))
+    harmonics = [k for k in (3, 4, 5, 6, 7, 8, 9, 10) if k in order and order[k][2] >= line_db
+                 and order[k][1] > 0.1 * max(v1, 1e-300)]
+    subs = [k for k in (0.5, 1.5, 2.5) if k in order and order[k][2] >= line_db]
+    loose = np.clip((len(harmonics) - 2) / 4 + 0.35 * len(subs), 0, 1) * level
+    if "speed_inconsistent" in flags:
+        loose *= 0.3  # the sub-harmonics are explained by the sampling-rate contradiction
+    rows.append(row("looseness", f1, None, None, float(len(harmonics)), loose,
+                    f"{len(harmonics)} harmonics above 2X, sub-harmonics at {subs or 'none'}"))
+    return rows, order
+
+
+def resonance_row(f, V, f1, order, level, rows, row, line_db):
+    """The noise floor raised into a hump around a shaft order: a structural mode there. An order
+    amplified by it is the resonance's doing, so unbalance/misalignment next to it lose confidence."""
+    df = f[1]
+    res_f, res_db = None, 0.0
+    for k in (1, 2, 3, 4):
+        if k not in order or order[k][2] < line_db:
+            continue
+        fk = k * f1
+        half = max(3.0, 0.1 * fk)
+        local = (np.abs(f - fk) <= half) & (np.abs(f - fk) > 4 * df)      # beside the tone, inside a hump
+        far = (f > 0.3 * fk) & (f < 3 * fk) & (np.abs(f - fk) > 0.3 * fk)   # the floor away from it
+        for j in order:                                                    # other order lines are not floor
+            far &= np.abs(f - j * f1) > 4 * df
+        if local.sum() < 8 or far.sum() < 8:
+            continue
+        db = float(20 * np.log10(np.median(V[local]) / max(np.median(V[far]), 1e-300)))
+        if db > res_db:
+            res_db, res_f = db, float(fk)
+    res_conf = level * float(np.clip((res_db - 10) / 6, 0, 1)) if res_f is not None else 0.0
+    for r in rows:
+        if res_f is not None and ((r["fault"] == "unbalance" and abs(res_f - f1) < 0.5 * f1) or
+                                  (r["fault"] == "misalignment" and abs(res_f - 2 * f1) < 0.5 * f1)):
+            r["confidence"] = float(r["confidence"] * (1 - res_conf))
+            r["note"] += f"; the order sits on a resonance (hump {res_db:.1f} dB)" if res_conf > 0 else ""
+    return row("resonance", res_f, res_f, None, res_db, res_conf,
+               f"noise floor raised {res_db:.1f} dB around the order at {res_f or 0:.1f} Hz (a structural mode there)")
+
+
+def electrical_row(f, A, f1, line_frequency, level, line, row, line_db):
+    """Twice line frequency (stator, air gap): a 2 x line line that is not a shaft order in disguise."""
+    df = f[1]
+    lf = positive(line_frequency, "line_frequency")
+    fo, am, db = line(f, A, 2 * lf, max(2.5 * df, 0.002 * lf), max(5.0, 10 * df))
+    not_order = abs(2 * lf - round(2 * lf / f1) * f1) > max(3 * df, 0.01 * f1)
+    return row("electrical", 2 * lf, fo, am, db, level * float(np.clip((db - line_db) / 12, 0, 1)) * not_order,
+               f"2 x line frequency ({2 * lf:g} Hz) line {db:.1f} dB")
+
+
+def gear_row(f, A, f1, gear, line, row, line_db):
+    """Gear mesh: teeth x 1X with sidebands at +-1X."""
+    df = f[1]
+    fm = gear.teeth * f1
+    fo, am, db = line(f, A, fm, max(2.5 * df, 0.005 * fm), max(2 * f1, 10 * df))
+    sb = [line(f, A, fm + s * f1, max(2.5 * df, 0.005 * fm), max(f1, 10 * df))[2] for s in (-1, 1)]
+    e = max(0.0, db - line_db) / 6 + sum(0.5 * max(0.0, s - line_db) / 6 for s in sb)
+    n_sb = sum(s >= line_db for s in sb)
+    return row("gear_mesh", fm, fo, am, db, (1 - np.exp(-e / 2)) * (n_sb >= 1),
+               f"mesh {gear.teeth} x 1X with sidebands at +-1X ({n_sb} found)")
