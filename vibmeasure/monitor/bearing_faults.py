@@ -12,8 +12,11 @@ Pipeline for one record (``bearing_evidence``):
    noise the ratio ``r`` is exponential with mean 1 (chi-square with 2 degrees of freedom over 2).
 3. explain: lines at exact shaft harmonics, then the cage comb (FTF harmonics that are not BPFO's),
    are claimed first; then the bearing families (BPFO; BPFI with +-1X sidebands; 2xBSF with +-FTF
-   sidebands, and BSF) are tested, the most significant family claims its lines, and the others are
-   tested again without them. A line is evidence for one family only.
+   sidebands, and BSF) are tested; of those that pass, the one with more (and stronger) of its own
+   first three harmonics claims its lines with their sidebands, and the others are tested again
+   without them. A line is evidence for one family only. An inner-race or ball family passes only
+   with its modulation sidebands (+-1X: the defect turns through the load zone; +-FTF: the ball
+   travels with the cage): a bare comb near BPFI or 2xBSF is not called.
 4. test: a family's statistic is the sum of r over its comb (harmonics 1-3 and sidebands) at the
    common slip (within +-2 %) that maximises it; under noise that sum is Gamma(n_terms) distributed,
    and the p-value is multiplied by the number of slip positions, bins and sub-models searched
@@ -137,7 +140,8 @@ def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
     carriers = [v for (h, k), v in zip(terms, vals[j]) if k == 0]
     return {"logp": float(min(logp, 0.0)), "slip": float(s[j]), "stat": float(T[j]), "n_terms": n_t,
             "strength": float(np.sum(carriers)),
-            "lines": lines, "n_lines": int(sum(v >= R_LINE for v in vals[j]))}
+            "lines": lines, "n_lines": int(sum(v >= R_LINE for v in vals[j])),
+            "n_carriers": int(sum(v >= R_LINE for v in carriers))}
 
 
 def _mask(ses: _SES, hz: float):
@@ -200,7 +204,29 @@ def _family(ses: _SES, name: str, freqs: dict, f1: float) -> dict | None:
                         + (f" +-{side}" if side else ""))
     if best is not None:
         best["logp"] = min(0.0, best["logp"] + np.log(len(models)))
+        best["modulation"] = _modulation(ses, name, freqs, f1)
+        car = _comb(ses, freqs[key], (1, 2, 3))
+        vals = [ln["r"] for ln in car["lines"]] if car else [0.0]
+        # who claims first: the family with more of its own first three harmonics standing out, then
+        # the stronger ones (capped, so that one huge shared line does not decide), then raw strength
+        best["order_key"] = (sum(v >= R_LINE for v in vals), float(np.minimum(vals, R_CAP).sum()), float(sum(vals)))
     return best
+
+
+MODULATION = {"bearing_inner_race": "1X", "bearing_ball": "FTF"}
+
+
+def _modulation(ses: _SES, name: str, freqs: dict, f1: float) -> int | None:
+    """How many modulation sidebands stand out: +-1X around BPFI harmonics (the defect turns through
+    the load zone with the shaft), +-FTF around 2xBSF harmonics (the ball travels with the cage).
+    None for the outer race, whose defect stays in the load zone."""
+    side = MODULATION.get(name)
+    if side is None:
+        return None
+    key = FAMILIES[name][0]
+    sp = (f1, 0.0) if side == "1X" else (freqs["FTF"], 1.0)
+    res = _comb(ses, freqs[key], (1, 2, 3), sp)
+    return 0 if res is None else sum(ln["r"] >= R_LINE for ln in res["lines"] if ln["sideband"] != 0)
 
 
 def _claim_family(ses: _SES, name: str, res: dict, freqs: dict, f1: float):
@@ -219,6 +245,13 @@ def _claim_family(ses: _SES, name: str, res: dict, freqs: dict, f1: float):
         h += 1
 
 
+def _accepted(res: dict | None) -> bool:
+    """Significant, at least two lines, one of them a harmonic of the family's own fundamental, and
+    (inner race, ball) the modulation sidebands of the fault."""
+    return bool(res and res["n_lines"] >= 2 and res["n_carriers"] >= 1 and res["logp"] < np.log(ALPHA)
+                and res.get("modulation") != 0)
+
+
 def _explain(ses: _SES, freqs: dict, f1: float, shaft_hz: float, f1_known: bool, n_balls: int):
     """Claim shaft and cage lines, then let the bearing families claim theirs, strongest first."""
     _claim_shaft(ses, shaft_hz, f1_known)
@@ -227,12 +260,10 @@ def _explain(ses: _SES, freqs: dict, f1: float, shaft_hz: float, f1_known: bool,
     while open_:
         for name in open_:
             ses.results[name] = _family(ses, name, freqs, f1)
-        ok = [n for n in open_ if ses.results[n] and ses.results[n]["n_lines"] >= 2
-              and ses.results[n]["logp"] < np.log(ALPHA)]
+        ok = [n for n in open_ if _accepted(ses.results[n])]
         if not ok:
             break
-        # the family whose own harmonics (not sidebands) are strongest claims its lines first
-        win = max(ok, key=lambda n: ses.results[n]["strength"])
+        win = max(ok, key=lambda n: ses.results[n]["order_key"])
         ses.results[win]["rank"] = len(FAMILIES) - len(open_) + 1
         if ses.primary is None:
             ses.primary = win
@@ -331,11 +362,13 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
         fams[name]["votes"] = len(votes.get(name, ()))
         if name in FAMILIES and not votes[name]:
             fams[name]["found"] = False   # only ever significant on lines another family explains better
-    n_votes = sum(len(v) for v in votes.values())
+    # each spectrum votes for the family that claimed first, with the weight of its evidence (-log p)
+    weight = {n: sum(-s.results[n]["logp"] for s in votes[n]) for n in FAMILIES}
+    total = sum(weight.values())
     names = list(FAMILIES)
     conf = _log_p_to_conf(np.array([fams[n]["log_p"] if fams[n]["found"] else 0.0 for n in names]))
     for n, c in zip(names, conf):
-        share = fams[n]["votes"] / n_votes if n_votes else 0.0
+        share = weight[n] / total if total > 0 else 0.0
         fams[n]["agreement"] = share
         fams[n]["confidence"] = float(c * share)
     fams["bearing_cage"]["confidence"] = 0.0
@@ -348,7 +381,8 @@ def _summary(name, key, res, ses, freqs, n_sp) -> dict:
         return {"fault": name, "expected_hz": expected, "found": False, "log_p": 0.0, "p_value": 1.0,
                 "statistic": 0.0, "n_terms": 0,
                 "log10_p": 0.0, "slip": np.nan, "found_hz": None, "lines": [], "n_lines": 0, "channel": None,
-                "preprocessing": None, "band_hz": None, "model": None, "amplitude": None, "evidence_db": 0.0}
+                "preprocessing": None, "band_hz": None, "model": None, "amplitude": None, "evidence_db": 0.0,
+                "modulation_sidebands": None}
     logp = min(0.0, res["logp"] + np.log(n_sp))
     df = ses.freq[1]
     f0 = expected * (1 + res["slip"])
@@ -356,10 +390,10 @@ def _summary(name, key, res, ses, freqs, n_sp) -> dict:
     lines = [dict(ln, db=float(10 * np.log10(max(ln["r"], 1e-12)))) for ln in res["lines"]]
     main = [ln for ln in lines if ln["sideband"] == 0]
     ev_db = float(np.mean([ln["db"] for ln in main])) if main else 0.0
-    found = bool(logp < np.log(ALPHA) and res["n_lines"] >= 2)
+    found = bool(logp < np.log(ALPHA) and _accepted(res))
     return {"fault": name, "expected_hz": expected, "found": found, "log_p": logp, "p_value": float(np.exp(logp)),
             "statistic": res["stat"], "n_terms": res["n_terms"],
             "log10_p": float(logp / np.log(10)), "slip": res["slip"], "found_hz": float(f0),
             "lines": lines, "n_lines": res["n_lines"], "channel": ses.channel, "preprocessing": ses.prep,
-            "band_hz": ses.band, "model": res.get("model"),
+            "band_hz": ses.band, "model": res.get("model"), "modulation_sidebands": res.get("modulation"),
             "amplitude": float(ses.amp[i]) if i < ses.amp.size else None, "evidence_db": ev_db}
