@@ -237,9 +237,23 @@ _FAULTS = ("none", "unbalance", "misalignment", "looseness", "bearing_outer_race
            "bearing_ball", "gear_mesh", "resonance")
 
 
+def _impact_train(n, fs, times, resonance_hz, amp=None):
+    """Unit-RMS response of a resonance (zeta 0.05) to impacts at the given times."""
+    wr = 2 * np.pi * resonance_hz
+    tau = 1 / (0.05 * wr)
+    idx = np.round(np.asarray(times) * fs).astype(int)
+    ok = idx < n
+    imp = np.zeros(n)
+    np.add.at(imp, idx[ok], np.ones(ok.sum()) if amp is None else np.asarray(amp)[ok])
+    tt = np.arange(int(8 * tau * fs)) / fs
+    out = np.convolve(imp, np.exp(-tt / tau) * np.sin(wr * tt))[:n]
+    return out / max(np.std(out), 1e-300)
+
+
 def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, duration: float = 10.0,
             severity: float = 1.0, snr_db: float = 20.0, bearing=None, gear_teeth: int = 32,
-            resonance_hz: float = 3500.0, seed=None, unit: str = "g") -> Record:
+            resonance_hz: float = 3500.0, cage_modulation: float = 0.0, shaft_impacts: float = 0.0,
+            seed=None, unit: str = "g") -> Record:
     """Accelerometer record of a rotating machine, healthy or with one fault, for tests and demos.
 
     Every machine has a small residual 1X and broadband noise. Faults: unbalance (strong 1X),
@@ -247,7 +261,11 @@ def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, du
     defects (impacts at BPFO/BPFI/BSF with 1 % slip jitter exciting a structural resonance; inner
     race and ball faults amplitude-modulated at 1X and FTF), gear mesh (teeth x 1X with 1X
     sidebands), resonance (a structural mode 6 % above 1X amplifying 1X and the broadband forces). ``severity`` scales the fault, ``snr_db`` is the fault signal's power over the noise.
-    The fault-free part is in g; meta holds rpm and the truth.
+    Nuisances that are no fault (stress cases for the diagnosis): ``cage_modulation`` (0..1) modulates
+    the broadband noise at the cage rate FTF and its harmonics, as an uneven cage or load does on a
+    healthy bearing; ``shaft_impacts`` (relative to the fault signal's RMS, or to 0.3 g without a
+    fault) adds one impact per revolution exciting the resonance (a rub): its envelope is a comb of
+    shaft harmonics. The fault-free part is in g; meta holds rpm and the truth.
     """
     from .models.bearing import BEARINGS, Bearing
     if fault not in _FAULTS:
@@ -286,16 +304,7 @@ def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, du
             amp = 1 + 0.8 * np.cos(2 * np.pi * f1 * times)       # the defect turns with the shaft
         elif fault == "bearing_ball":
             amp = 1 + 0.8 * np.cos(2 * np.pi * fr["FTF"] * times)  # the ball travels with the cage
-        wr = 2 * np.pi * resonance_hz
-        tau = 1 / (0.05 * wr)  # resonance with zeta 0.05
-        idx = np.round(times * fs).astype(int)
-        imp = np.zeros(n)
-        np.add.at(imp, idx[idx < n], amp[idx < n])
-        L = int(8 * tau * fs)
-        tt = np.arange(L) / fs
-        h = np.exp(-tt / tau) * np.sin(wr * tt)
-        sig = np.convolve(imp, h)[:n]
-        sig *= 1.0 / max(np.std(sig), 1e-300) * 0.3
+        sig = 0.3 * _impact_train(n, fs, times, resonance_hz, amp)  # resonance with zeta 0.05
     elif fault == "gear_mesh":
         fm = gear_teeth * f1
         sig = 0.3 * (1 + 0.5 * np.cos(2 * np.pi * f1 * t)) * np.sin(2 * np.pi * fm * t + ph()) \
@@ -311,6 +320,17 @@ def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, du
     sig = severity * sig
     p_sig = np.mean(sig ** 2) if fault != "none" else np.mean((0.3 * np.ones(1)) ** 2) / 2
     noise = rng.normal(0, np.sqrt(p_sig / 10 ** (snr_db / 10)), n)
+    if not 0 <= cage_modulation <= 1:
+        raise ParameterError(f"{cage_modulation=} must be between 0 and 1 (modulation depth)")
+    if cage_modulation:
+        th = 2 * np.pi * b.frequencies(f1)["FTF"] * t + rng.uniform(0, 2 * np.pi)
+        noise *= 1 + cage_modulation * (np.cos(th) + 0.5 * np.cos(2 * th) + 0.3 * np.cos(3 * th)) / 1.8
+    if shaft_impacts < 0:
+        raise ParameterError(f"{shaft_impacts=} must be >= 0")
+    if shaft_impacts:
+        sig = sig + shaft_impacts * np.sqrt(2 * p_sig) * _impact_train(n, fs, np.arange(rng.uniform(0, 1 / f1),
+                                                                                       duration, 1 / f1),
+                                                                       resonance_hz)
     x = base + sig + noise
     from .core.record import Channel as _Ch
     truth = {"kind": "machine", "fault": fault, "rpm": rpm, "severity": severity, "snr_db": snr_db}

@@ -64,6 +64,7 @@ class _SES:
     results: dict = field(default_factory=dict)
     primary: str | None = None   # the family that claimed its lines first
     kurtogram: object = None
+    r_base: np.ndarray | None = None
     shape: int = 1               # r is the mean of this many independent spectra (Gamma(shape)/shape)
 
     @property
@@ -209,7 +210,7 @@ def _family(ses: _SES, name: str, freqs: dict, f1: float) -> dict | None:
         res = _comb(ses, freqs[key], harmonics, sp)
         if res is not None and (best is None or res["logp"] < best["logp"]):
             best = dict(res, model=f"{key} x {','.join(f'{h:g}' for h in harmonics)}"
-                        + (f" +-{side}" if side else ""))
+                        + (f" +-{side}" if side else ""), spec=(harmonics, sp, len(models)))
     if best is not None:
         best["logp"] = min(0.0, best["logp"] + np.log(len(models)))
         best["modulation"] = _modulation(ses, name, freqs, f1)
@@ -264,6 +265,7 @@ def _explain(ses: _SES, freqs: dict, f1: float, shaft_hz: float, f1_known: bool,
     """Claim shaft and cage lines, then let the bearing families claim theirs, strongest first."""
     _claim_shaft(ses, shaft_hz, f1_known)
     ses.results["bearing_cage"] = _claim_cage(ses, freqs["FTF"], n_balls)
+    ses.r_base = ses.r.copy()  # what the bearing families compete for (decoys are scored on it)
     open_ = list(FAMILIES)
     while open_:
         for name in open_:
@@ -335,6 +337,30 @@ def _spectra(x: np.ndarray, fs: float, name: str, f1: float, freqs: dict, band,
     return out
 
 
+N_DECOYS = 120
+
+
+def _decoy_p(ses: _SES, res: dict, f0: float, freqs: dict) -> float:
+    """Empirical false-alarm probability of a family's comb on this spectrum: the share of decoy
+    combs of the same shape, at fundamentals that are no bearing frequency (0.55-1.8 x f0, away from
+    every family's harmonics and sub-harmonics), that score as well. It measures how easily this
+    spectrum's own lines (other machine parts, electrical, structure) make a comb by chance, which
+    the Gaussian-noise p-value cannot know."""
+    harmonics, sp, _ = res["spec"]
+    u = np.geomspace(0.55, 1.8, 4 * N_DECOYS)
+    fund = [freqs[k] for k in ("BPFO", "BPFI", "2xBSF", "BSF", "FTF")]
+    ratios = np.array([h * F / m / f0 for F in fund for h in (1, 2, 3) for m in (1, 2, 3)])
+    keep = np.all(np.abs(u[:, None] / ratios[None, :] - 1) > 0.05, axis=1)
+    u = u[keep][:: max(1, keep.sum() // N_DECOYS)][:N_DECOYS]
+    saved, ses.r = ses.r, ses.r_base if ses.r_base is not None else ses.r
+    try:
+        scores = [c["logp"] for c in (_comb(ses, f0 * ui, harmonics, sp) for ui in u) if c is not None]
+    finally:
+        ses.r = saved
+    raw = res["logp"] - np.log(res["spec"][2])  # the family's own score before the sub-model correction
+    return float((1 + sum(sc <= raw for sc in scores)) / (1 + len(scores)))
+
+
 def _fused(spectra: list) -> list:
     """Per pre-processing, the mean of the channels' normalised spectra: a fault that shows weakly in
     several sensors adds up (under noise the mean of C ratios is Gamma(C)/C)."""
@@ -387,6 +413,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
             if res is not None and (best is None or res["logp"] < best["logp"]):
                 best, where = res, s
         fams[name] = _summary(name, key, best, where, freqs, n_sp)
+        if name in FAMILIES and best is not None and "spec" in best:
+            fams[name]["decoy_p"] = _decoy_p(where, best, freqs[key], freqs)
         fams[name]["votes"] = len(votes.get(name, ()))
         if name in FAMILIES and not votes[name]:
             fams[name]["found"] = False   # only ever significant on lines another family explains better
@@ -398,7 +426,9 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     for n, c in zip(names, conf):
         share = weight[n] / total if total > 0 else 0.0
         fams[n]["agreement"] = share
-        fams[n]["confidence"] = float(c * share)
+        # the posterior from the p-value, times the share of the spectra's votes, times the share of
+        # decoy combs the family beats on its own spectrum
+        fams[n]["confidence"] = float(c * share * (1.0 - fams[n].get("decoy_p", 1.0)))
     fams["bearing_cage"]["confidence"] = 0.0
     return {"families": fams, "spectra": spectra, "kurtogram": kg, "n_spectra": n_sp}
 

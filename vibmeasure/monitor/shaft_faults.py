@@ -65,11 +65,13 @@ def resonance_row(f, V, f1, order, level, rows, row, line_db):
         if db > res_db:
             res_db, res_f = db, float(fk)
     res_conf = level * float(np.clip((res_db - 10) / 6, 0, 1)) if res_f is not None else 0.0
+    # a hump of 6-12 dB is ambiguous: it already makes an order's own fault less certain
+    doubt = level * float(np.clip((res_db - 6) / 6, 0, 1)) if res_f is not None else 0.0
     for r in rows:
         if res_f is not None and ((r["fault"] == "unbalance" and abs(res_f - f1) < 0.5 * f1) or
                                   (r["fault"] == "misalignment" and abs(res_f - 2 * f1) < 0.5 * f1)):
-            r["confidence"] = float(r["confidence"] * (1 - res_conf))
-            r["note"] += f"; the order sits on a resonance (hump {res_db:.1f} dB)" if res_conf > 0 else ""
+            r["confidence"] = float(r["confidence"] * (1 - doubt))
+            r["note"] += f"; the order sits on a resonance (hump {res_db:.1f} dB)" if doubt > 0 else ""
     return row("resonance", res_f, res_f, None, res_db, res_conf,
                f"noise floor raised {res_db:.1f} dB around the order at {res_f or 0:.1f} Hz (a structural mode there)")
 
