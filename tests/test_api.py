@@ -10,7 +10,8 @@ import pytest
 import vibmeasure as vm
 
 PUBLIC_FUNCS = [vm.read, vm.write, vm.ringdown, vm.ringdown_crb, vm.log_decrement, vm.hilbert_decay,
-                vm.half_power, vm.synth.free_decay, vm.synth.coulomb_decay]
+                vm.half_power, vm.synth.free_decay, vm.synth.coulomb_decay, vm.diagnose, vm.prewhiten,
+                vm.remove_synchronous, vm.kurtogram, vm.band_ses]
 
 
 def test_contract_names_exist():

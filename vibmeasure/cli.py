@@ -114,7 +114,8 @@ def _parser() -> argparse.ArgumentParser:
     dg.add_argument("file", help="acceleration record")
     dg.add_argument("--rpm", type=float, help="declared shaft speed (default: the file's rpm variable)")
     g = dg.add_mutually_exclusive_group()
-    g.add_argument("--bearing", help="catalogue bearing (6205-2RS, 6203-2RS)")
+    g.add_argument("--bearing", help="catalogue bearing: 6205-2RS, 6203-2RS (CWRU), MFPT, ZA-2115 (IMS), UER204 "
+                                     "(XJTU-SY), ER16K (Ottawa), or a nominal 6200-6212 / 6300-6312")
     g.add_argument("--bearing-geometry", metavar="N,d,D,angle", help="balls, ball and pitch diameter, angle (deg)")
     dg.add_argument("--gear", type=int, metavar="TEETH", help="teeth of a gear on this shaft")
     dg.add_argument("--line-frequency", type=float, choices=(50.0, 60.0), help="mains frequency: check 2 x line")
@@ -122,7 +123,11 @@ def _parser() -> argparse.ArgumentParser:
     dg.add_argument("--foundation", choices=("rigid", "flexible"), default="rigid")
     dg.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
     dg.add_argument("--unit", default=None, help="unit of the data when the file does not say (e.g. g)")
-    dg.add_argument("--channel", help="channel to diagnose (default: the first)")
+    dg.add_argument("--channel", action="append", help="channel to diagnose; repeat to name several (the first gives "
+                                                       "speed, severity and shaft orders; bearing faults are searched in "
+                                                       "all named). Default: every channel of the file")
+    dg.add_argument("--prewhitening", nargs="+", choices=("cepstral", "ar"), default=["cepstral"],
+                    help="pre-whitening before envelope analysis (default cepstral)")
     dg.add_argument("--json", action="store_true", help="print one JSON document")
     dg.add_argument("--plot", metavar="OUT.png", help="spectra with the fault lines and a severity gauge")
     return p
@@ -134,7 +139,7 @@ def _main_diagnose(args, out, err) -> int:
     from .monitor.machinery import diagnose
     try:
         rec = io.read(args.file, fs=args.fs, unit=args.unit, quantity="acceleration" if args.unit else None,
-                      channels=[args.channel] if args.channel else None)
+                      channels=args.channel)
         bearing = args.bearing
         if args.bearing_geometry:
             try:
@@ -143,12 +148,13 @@ def _main_diagnose(args, out, err) -> int:
                 raise VibMeasureError(f"--bearing-geometry {args.bearing_geometry!r} must be N,d,D,angle") from None
             bearing = Bearing(int(n), d, D, ang)
         diag = diagnose(rec, rpm=args.rpm, bearing=bearing, gear=args.gear, machine_group=args.group,
-                        foundation=args.foundation, channel=0, line_frequency=args.line_frequency)
+                        foundation=args.foundation, channel=0, line_frequency=args.line_frequency,
+                        prewhitening=tuple(args.prewhitening))
         if args.plot:
             import matplotlib
             matplotlib.use("Agg")
             from .plot import plot_diagnosis
-            axes = plot_diagnosis(rec.select(0), diag)
+            axes = plot_diagnosis(rec, diag)
             _save_figure(axes[0].figure, args.plot)
     except (VibMeasureError, OSError) as exc:
         print(f"vibmeasure: error: {exc}", file=err)
@@ -158,8 +164,12 @@ def _main_diagnose(args, out, err) -> int:
         out.write("\n")
     else:
         sev = diag.severity
-        print(f"{args.file}: {diag.top.upper()} (confidence {diag.confidence:.2f})", file=out)
+        where = f" in {diag.channel}" if diag.top != "none" else ""
+        scope = " among the shaft-order faults; bearing faults NOT CHECKED" if not diag.bearing_checked else ""
+        print(f"{args.file}: {diag.top.upper()} (confidence {diag.confidence:.2f}){where}{scope}", file=out)
         print(f"  {diag.reason}", file=out)
+        if not diag.bearing_checked:
+            print("  bearing faults: not checked (give --bearing or --bearing-geometry)", file=out)
         est = diag.speed.get("estimated_rpm")
         print(f"  speed: declared {diag.speed['declared_rpm']:g} rpm, estimated "
               f"{'n/a' if est is None else format(est, '.1f')} rpm {diag.speed['note']}", file=out)
@@ -167,7 +177,9 @@ def _main_diagnose(args, out, err) -> int:
             print(f"  severity: {sev['velocity_rms_mm_s']:.2f} mm/s RMS ({sev['band_hz'][0]:g}-1000 Hz), ISO 10816-3 "
                   f"group {sev['group']} {sev['foundation']}: zone {sev['zone']} {sev['note']}", file=out)
         for _, r in diag.faults.iterrows():
-            print(f"  {r.fault:20s} expected {r.expected_hz:9.2f} Hz  confidence {r.confidence:.2f}", file=out)
+            p = r.get("p_value")
+            extra = f"  p = {p:.2g} ({r.channel}, {r.preprocessing})" if p is not None and p == p and p < 1 else ""
+            print(f"  {r.fault:20s} expected {r.expected_hz:9.2f} Hz  confidence {r.confidence:.2f}{extra}", file=out)
     if args.plot:
         print(f"vibmeasure: wrote {args.plot}", file=err)
     return 0

@@ -212,31 +212,37 @@ def plot_mac(matrix, *, labels=None, ax=None):
 
 
 def plot_diagnosis(rec, diag, *, axes=None):
-    """Envelope spectrum (when a bearing was given) and amplitude spectrum with the expected fault
-    lines drawn and labelled, and an ISO 10816-3 severity gauge. Returns the axes."""
+    """The squared-envelope spectrum that carries the bearing evidence (in dB over its floor) with the
+    winning family's comb at its slip, its sidebands and the other families' expected lines; the fast
+    kurtogram of that channel with the chosen band; the amplitude spectrum with the shaft orders; an
+    ISO 10816-3 severity gauge. Returns the axes (envelope, spectrum, gauge, kurtogram)."""
     import matplotlib.pyplot as plt
-    from .signal.demod import envelope_spectrum
     from .signal.spectral import amplitude_spectrum
     if axes is None:
-        fig = plt.figure(figsize=(10, 6.5))
-        gs = fig.add_gridspec(2, 4)
-        axes = (fig.add_subplot(gs[0, :3]), fig.add_subplot(gs[1, :3]), fig.add_subplot(gs[:, 3]))
-    ax_e, ax_s, ax_g = axes
-    tab = diag.faults
+        fig = plt.figure(figsize=(12, 8), layout="constrained")
+        gs = fig.add_gridspec(3, 5, height_ratios=(1.2, 1, 1))
+        axes = (fig.add_subplot(gs[0, :4]), fig.add_subplot(gs[2, :4]), fig.add_subplot(gs[:, 4]),
+                fig.add_subplot(gs[1, :4]))
+    ax_e, ax_s, ax_g = axes[:3]
+    ax_k = axes[3] if len(axes) > 3 else None
     colors = {"bearing_outer_race": "C3", "bearing_inner_race": "C1", "bearing_ball": "C4", "bearing_cage": "C5",
               "unbalance": "C0", "misalignment": "C2", "looseness": "C6", "gear_mesh": "C8"}
-    if diag.envelope_band_hz:
-        es = envelope_spectrum(rec, band=diag.envelope_band_hz)
-        fmax = 4 * max(tab.loc[tab.fault.str.startswith("bearing"), "expected_hz"].max(), 1.0)
-        sel = es.freq <= fmax
-        ax_e.plot(es.freq[sel], es.values[0, sel], lw=0.7, color="0.3")
-        for _, r in tab[tab.fault.str.startswith("bearing")].iterrows():
-            for k in (1, 2, 3):
-                ax_e.axvline(k * r.expected_hz, color=colors[r.fault], lw=0.7, ls="--")
-            ax_e.text(r.expected_hz, 0.98, f" {r.fault.split('_', 1)[1]} {r.confidence:.2f}",
-                      transform=ax_e.get_xaxis_transform(), rotation=90, va="top", fontsize=7, color=colors[r.fault])
-        ax_e.set_title(f"squared-envelope spectrum, band {diag.envelope_band_hz[0]:.0f}-{diag.envelope_band_hz[1]:.0f} "
-                       f"Hz: top = {diag.top}", fontsize=9)
+    ses = diag.extras.get("ses")
+    if ses is not None:
+        _plot_ses(ax_e, ses, diag, colors)
+    else:
+        ax_e.text(0.5, 0.5, "bearing faults not checked (no bearing given)", ha="center", va="center",
+                  transform=ax_e.transAxes)
+        ax_e.set_axis_off()
+    if ax_k is not None:
+        kg = diag.extras.get("kurtogram")
+        if kg is not None:
+            _plot_kurtogram(ax_k, kg, ses["band_hz"] if ses else None)
+        else:
+            ax_k.set_axis_off()
+    primary = diag.extras.get("primary")
+    if primary is not None and primary in rec.names:
+        rec = rec.select(primary)
     s = amplitude_spectrum(rec)
     f1 = (diag.speed.get("estimated_rpm") or diag.speed["declared_rpm"]) / 60
     sel = s.freq <= 12 * f1
@@ -244,7 +250,7 @@ def plot_diagnosis(rec, diag, *, axes=None):
     for k in range(1, 11):
         ax_s.axvline(k * f1, color="C0", lw=0.5, ls=":")
     ax_s.set_xlabel("frequency [Hz]")
-    ax_s.set_title(f"spectrum with shaft orders 1X..10X (1X = {f1:.2f} Hz)", fontsize=9)
+    ax_s.set_title(f"spectrum of {rec.names[0]} with shaft orders 1X..10X (1X = {f1:.2f} Hz)", fontsize=9)
     sev = diag.severity
     from .monitor.machinery import ISO_10816_3
     ab, bc, cd = ISO_10816_3[(sev["group"], sev["foundation"])]
@@ -255,9 +261,57 @@ def plot_diagnosis(rec, diag, *, axes=None):
     v = sev.get("velocity_rms_mm_s")
     if v is not None:
         ax_g.plot([-0.35, 0.35], [min(v, top)] * 2, color="k", lw=3)
-        ax_g.set_title(f"ISO 10816-3\n{v:.2f} mm/s: zone {sev['zone']}", fontsize=9)
+        ax_g.set_title(f"ISO 10816-3\n{v:.2f} mm/s: zone {sev['zone']}", fontsize=8)
     ax_g.set_xlim(-0.5, 0.6)
     ax_g.set_ylim(0, top)
     ax_g.set_xticks([])
     ax_g.set_ylabel("velocity RMS [mm/s]")
     return axes
+
+
+def _plot_ses(ax, ses, diag, colors):
+    """SES in dB over its median floor, the winning comb (solid), its sidebands (dotted) and the other
+    families' expected first harmonics (thin)."""
+    freq, amp = np.asarray(ses["freq"]), np.asarray(ses["amp"])
+    tab = diag.faults.set_index("fault")
+    fam = ses["family"]
+    f0 = tab.loc[fam, "expected_hz"]
+    fmax = min(freq[-1], 5.5 * float(tab.loc[tab.index.str.startswith("bearing"), "expected_hz"].max()))
+    sel = (freq > 0) & (freq <= fmax)
+    floor = np.median(amp[sel] ** 2)
+    ax.plot(freq[sel], 10 * np.log10(np.maximum(amp[sel] ** 2, 1e-300) / floor), lw=0.6, color="0.35")
+    for ln in ses["lines"]:
+        style = "-" if ln["sideband"] == 0 else ":"
+        ax.axvline(ln["hz"], color=colors.get(fam, "C3"), lw=0.9, ls=style, alpha=0.8)
+        if ln["db"] >= 7.8:
+            ax.plot(ln["hz"], ln["db"], "v", color=colors.get(fam, "C3"), ms=5)
+    for other, r in tab.iterrows():
+        if other.startswith("bearing") and other != fam and np.isfinite(r.expected_hz):
+            ax.axvline(r.expected_hz, color=colors.get(other, "0.5"), lw=0.5, ls="--", alpha=0.6)
+            ax.text(r.expected_hz, 0.02, f" {other.split('_', 1)[1]}", transform=ax.get_xaxis_transform(),
+                    rotation=90, fontsize=6, color=colors.get(other, "0.5"))
+    slip = ses.get("slip")
+    p = tab.loc[fam, "p_value"]
+    f1 = (diag.speed.get("estimated_rpm") or diag.speed["declared_rpm"]) / 60
+    for k in range(1, int(fmax / f1) + 1):
+        ax.axvline(k * f1, color="C0", lw=0.4, ls=(0, (1, 3)), alpha=0.5)
+    ax.set_title(f"squared-envelope spectrum ({ses['preprocessing']}, {ses['band_hz'][0]:.0f}-{ses['band_hz'][1]:.0f} Hz, "
+                 f"{ses['channel']}); top = {diag.top}\n{fam.split('_', 1)[1]} comb (solid, sidebands dotted) at "
+                 f"{f0:.2f} Hz x (1 {(slip if np.isfinite(slip) else 0) * 100:+.2f} % slip), p = {p:.2g}; "
+                 "shaft orders faint blue", fontsize=8, loc="left")
+    ax.set_ylabel("dB over floor")
+    ax.set_xlim(0, fmax)
+
+
+def _plot_kurtogram(ax, kg, band):
+    """Fast kurtogram (levels x frequency) with the band the evidence came from outlined."""
+    img = kg.image("kurtosis")
+    ax.imshow(img, aspect="auto", origin="upper", cmap="viridis", interpolation="nearest",
+              extent=(0, kg.fs / 2, len(kg.levels) - 0.5, -0.5))
+    ax.set_yticks(range(len(kg.levels)), [f"{lv:g}" for lv in kg.levels])
+    ax.set_ylabel("level")
+    if band is not None:
+        ax.axvspan(band[0], band[1], fill=False, ec="w", lw=1.2)
+    lo, hi, lev, val = kg.best("kurtosis")
+    ax.set_title(f"fast kurtogram (cepstral-whitened): max kurtosis {val:.2f} in {lo:.0f}-{hi:.0f} Hz "
+                 f"(level {lev:g}); outlined: band of the evidence", fontsize=8)

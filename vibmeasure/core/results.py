@@ -10,7 +10,7 @@ import numpy as np
 
 from .errors import ParameterError
 
-__all__ = ["ModalEstimate", "Spectrum", "Spectrogram", "Peaks", "FRF", "FLAG_TEXT"]
+__all__ = ["ModalEstimate", "Spectrum", "Spectrogram", "Peaks", "FRF", "Kurtogram", "FLAG_TEXT"]
 
 # Every quality flag a result may carry, with the sentence a report prints for it.
 FLAG_TEXT = {
@@ -397,3 +397,40 @@ class FRF:
     def __repr__(self) -> str:
         return (f"FRF({self.form}, {self.n_outputs} out x {self.n_inputs} in x {self.freq.size} lines, "
                 f"df={self.df:.4g} Hz, {self.estimator or 'given'})")
+
+
+@dataclass(frozen=True)
+class Kurtogram:
+    """Per level of the 1/3-binary tree: ``levels`` (0, 1, 1.6, 2, ...), ``n_bands``, and per band
+    ``kurtosis`` and ``negentropy`` (lists of arrays, one per level; negentropy is the mean of the
+    time- and frequency-domain excess). ``band`` is the chosen (lo, hi) in Hz by ``criterion``."""
+
+    fs: float
+    levels: tuple
+    n_bands: tuple
+    kurtosis: tuple
+    negentropy: tuple
+    band: tuple
+    criterion: str
+    value: float
+    min_bandwidth: float
+    params: dict = field(default_factory=dict)
+
+    def best(self, criterion: str = "kurtosis") -> tuple:
+        """(lo, hi, level, value) of the band with the largest kurtosis or negentropy."""
+        rows = self.kurtosis if criterion == "kurtosis" else self.negentropy
+        best = (np.nan, np.nan, np.nan, -np.inf)
+        for lev, nb, vals in zip(self.levels, self.n_bands, rows):
+            if np.isfinite(vals).any() and np.nanmax(vals) > best[3]:
+                i = int(np.nanargmax(vals))
+                bw = self.fs / 2 / nb
+                best = (i * bw, (i + 1) * bw, lev, float(vals[i]))
+        return best
+
+    def image(self, criterion: str = "kurtosis", n_cols: int = 768) -> np.ndarray:
+        """The map as an image (levels x frequency columns) for plotting."""
+        rows = self.kurtosis if criterion == "kurtosis" else self.negentropy
+        out = np.full((len(rows), n_cols), np.nan)
+        for r, (nb, vals) in enumerate(zip(self.n_bands, rows)):
+            out[r] = vals[np.minimum((np.arange(n_cols) * nb) // n_cols, nb - 1)]
+        return out

@@ -179,10 +179,13 @@ def _check_nyquist(fs, f1, bearing, gear):
 
 # --- spectrum, speed, severity -------------------------------------------------------------------------
 
-def _spectrum(job: _Job):
-    """Hann amplitude spectrum of the primary channel (acceleration) and the velocity spectrum from it."""
+def _spectrum(job: _Job, window="hann"):
+    """Amplitude spectrum of the primary channel (acceleration) and the velocity spectrum from it.
+    Hann for lines; Blackman-Harris (sidelobes below -92 dB) where the floor beside a strong line
+    is measured, so the line's own leakage is not taken for a raised floor."""
+    from scipy.signal import get_window
     n = job.a.size
-    win = np.hanning(n)
+    win = np.hanning(n) if window == "hann" else get_window(window, n, fftbins=False)
     A = np.abs(np.fft.rfft((job.a - job.a.mean()) * win)) * 2 / win.sum()
     f = np.fft.rfftfreq(n, 1 / job.fs)
     V = np.where(f > 0, A / (2 * np.pi * np.maximum(f, 1e-12)), 0.0)  # velocity amplitude
@@ -352,7 +355,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     severity, level = _severity(job, f, job.rpm)
     v_rms = severity["velocity_rms_mm_s"] if severity["velocity_rms_mm_s"] is not None else np.nan
     rows, order = sf.shaft_order_rows(f, V, f1, v_rms, level, job.flags, _line, _row, LINE_DB)
-    rows.append(sf.resonance_row(f, V, f1, order, level, rows, _row, LINE_DB))
+    rows.append(sf.resonance_row(f, _spectrum(job, "blackmanharris")[1], f1, order, level, rows, _row, LINE_DB))
     if line_frequency is not None:
         rows.append(sf.electrical_row(f, A, f1, line_frequency, level, _line, _row, LINE_DB))
     b_rows, ev = _bearing_rows(job, f1, speed)
@@ -366,7 +369,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         reason += "; " + speed["note"]
     if job.bearing is None:
         job.flags.append("bearing_not_checked")
-    extras = {"also": also}
+    extras = {"also": also, "primary": job.primary}
     env_band = ()
     if ev is not None:
         extras.update(_plot_material(ev, top))
@@ -386,8 +389,8 @@ def _plot_material(ev, top):
         if sp.channel == s["channel"] and sp.prep == s["preprocessing"] and sp.band == s["band_hz"]:
             pick = sp
             break
-    kg = next((sp.kurtogram for sp in ev["spectra"] if sp.channel == pick.channel and sp.kurtogram is not None),
-              None)
+    kg = next((sp.kurtogram for sp in ev["spectra"] if sp.channel in pick.channel.split("+")
+               and sp.kurtogram is not None), None)
     ses = {"freq": pick.freq, "amp": pick.amp, "channel": pick.channel, "preprocessing": pick.prep,
            "band_hz": pick.band, "family": name, "slip": s["slip"], "lines": s["lines"]}
     return {"bearing": {k: {kk: vv for kk, vv in v.items() if kk != "lines"} for k, v in fams.items()},

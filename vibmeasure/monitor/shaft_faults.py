@@ -46,7 +46,9 @@ def shaft_order_rows(f, V, f1, v_rms, level, flags, line, row, line_db):
 
 
 def resonance_row(f, V, f1, order, level, rows, row, line_db):
-    """The noise floor raised into a hump around a shaft order: a structural mode there. An order
+    """The noise floor raised into a hump around a shaft order: a structural mode there (V: an
+    acceleration spectrum, flat for broadband forces, with a low-sidelobe window; lines +-6 bins left
+    out). An order
     amplified by it is the resonance's doing, so unbalance/misalignment next to it lose confidence."""
     df = f[1]
     res_f, res_db = None, 0.0
@@ -55,18 +57,19 @@ def resonance_row(f, V, f1, order, level, rows, row, line_db):
             continue
         fk = k * f1
         half = max(3.0, 0.1 * fk)
-        local = (np.abs(f - fk) <= half) & (np.abs(f - fk) > 4 * df)      # beside the tone, inside a hump
+        local = (np.abs(f - fk) <= half) & (np.abs(f - fk) > 6 * df)      # beside the tone, inside a hump
         far = (f > 0.3 * fk) & (f < 3 * fk) & (np.abs(f - fk) > 0.3 * fk)   # the floor away from it
         for j in order:                                                    # other order lines are not floor
-            far &= np.abs(f - j * f1) > 4 * df
+            far &= np.abs(f - j * f1) > 6 * df
         if local.sum() < 8 or far.sum() < 8:
             continue
         db = float(20 * np.log10(np.median(V[local]) / max(np.median(V[far]), 1e-300)))
         if db > res_db:
             res_db, res_f = db, float(fk)
-    res_conf = level * float(np.clip((res_db - 10) / 6, 0, 1)) if res_f is not None else 0.0
-    # a hump of 6-12 dB is ambiguous: it already makes an order's own fault less certain
-    doubt = level * float(np.clip((res_db - 6) / 6, 0, 1)) if res_f is not None else 0.0
+    # a healthy machine's acceleration floor is flat to about 1 dB around the orders: a hump from 5 dB
+    # on is a mode (full weight at 10 dB); from 3 dB on it already casts doubt on the order's own fault
+    res_conf = level * float(np.clip((res_db - 5) / 5, 0, 1)) if res_f is not None else 0.0
+    doubt = level * float(np.clip((res_db - 3) / 4, 0, 1)) if res_f is not None else 0.0
     for r in rows:
         if res_f is not None and ((r["fault"] == "unbalance" and abs(res_f - f1) < 0.5 * f1) or
                                   (r["fault"] == "misalignment" and abs(res_f - 2 * f1) < 0.5 * f1)):

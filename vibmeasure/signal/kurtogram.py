@@ -12,54 +12,16 @@ normalised squared envelope x, in the time domain (impulsiveness) and in the env
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 from scipy import fft as _fft
 
 from ..core._validate import as_record, clean_signal, positive, response_channel
 from ..core.errors import ParameterError
+from ..core.results import Kurtogram
 
 __all__ = ["kurtogram", "Kurtogram", "band_ses"]
 
 _GAUSS_NEGENTROPY = 1.0 - np.euler_gamma  # E[x ln x] for x ~ Exp(1): the squared envelope of noise
-
-
-@dataclass(frozen=True)
-class Kurtogram:
-    """Per level of the 1/3-binary tree: ``levels`` (0, 1, 1.6, 2, ...), ``n_bands``, and per band
-    ``kurtosis`` and ``negentropy`` (lists of arrays, one per level; negentropy is the mean of the
-    time- and frequency-domain excess). ``band`` is the chosen (lo, hi) in Hz by ``criterion``."""
-
-    fs: float
-    levels: tuple
-    n_bands: tuple
-    kurtosis: tuple
-    negentropy: tuple
-    band: tuple
-    criterion: str
-    value: float
-    min_bandwidth: float
-    params: dict = field(default_factory=dict)
-
-    def best(self, criterion: str = "kurtosis") -> tuple:
-        """(lo, hi, level, value) of the band with the largest kurtosis or negentropy."""
-        rows = self.kurtosis if criterion == "kurtosis" else self.negentropy
-        best = (np.nan, np.nan, np.nan, -np.inf)
-        for lev, nb, vals in zip(self.levels, self.n_bands, rows):
-            if np.isfinite(vals).any() and np.nanmax(vals) > best[3]:
-                i = int(np.nanargmax(vals))
-                bw = self.fs / 2 / nb
-                best = (i * bw, (i + 1) * bw, lev, float(vals[i]))
-        return best
-
-    def image(self, criterion: str = "kurtosis", n_cols: int = 768) -> np.ndarray:
-        """The map as an image (levels x frequency columns) for plotting."""
-        rows = self.kurtosis if criterion == "kurtosis" else self.negentropy
-        out = np.full((len(rows), n_cols), np.nan)
-        for r, (nb, vals) in enumerate(zip(self.n_bands, rows)):
-            out[r] = vals[np.minimum((np.arange(n_cols) * nb) // n_cols, nb - 1)]
-        return out
 
 
 def _tree(max_level: float):

@@ -1,0 +1,174 @@
+"""The bearing-family test: its false-alarm rate on noise, slip search, line ownership (a line counts
+for one family only), modulation sidebands, stress cases that must not become bearing calls, and the
+real recordings of ../shared/data (CWRU fan and drive end, MFPT) with the evidence each call rests on."""
+import warnings
+
+import numpy as np
+import pytest
+import scipy.io as sio
+
+import vibmeasure as vm
+from vibmeasure.monitor import bearing_faults as bf
+
+B6205 = vm.BEARINGS["6205-2RS"]
+F1 = 29.95
+
+
+def _ses(r, df=0.1):
+    """A normalised SES built by hand: r (power over floor) on a df grid."""
+    freq = np.arange(r.size) * df
+    return bf._SES("acc", "test", (0.0, 1.0), freq, np.sqrt(r), r, r.size)
+
+
+def test_false_alarm_rate_on_gaussian_noise():
+    # white noise holds no comb: no family may be found, and the corrected p-values must not be
+    # anti-conservative (under the null P(p < 0.05) <= 0.05; 60 p-values, binomial 99.9 % bound: 9)
+    freqs = B6205.frequencies(F1)
+    p = []
+    for seed in range(20):
+        x = np.random.default_rng(seed).normal(size=36000)
+        ev = bf.bearing_evidence({"acc": x}, 12000.0, F1, freqs, 9)
+        for name in bf.FAMILIES:
+            assert not ev["families"][name]["found"], (seed, name, ev["families"][name])
+            p.append(ev["families"][name]["p_value"])
+    assert sum(pi < 0.05 for pi in p) <= 9
+
+
+def test_comb_recovers_the_common_slip(rng):
+    # an Exp(1) floor with a BPFO comb (harmonics 1-3) 1.3 % above its catalogue frequency
+    r = rng.exponential(size=8000)
+    f0, slip, df = 107.36, 0.013, 0.1
+    for h in (1, 2, 3):
+        r[int(round(h * f0 * (1 + slip) / df))] = 40.0
+    res = bf._comb(_ses(r, df), f0, (1, 2, 3))
+    assert res["slip"] == pytest.approx(slip, abs=0.5 * df / (3 * f0))  # half a bin at the 3rd harmonic
+    assert res["n_lines"] == 3 and res["n_carriers"] == 3
+    # p-value: three capped lines (3 x 20) over Gamma(3), times slip positions and bins searched
+    m_eff = int(2 * bf.SLIP * 3 * f0 * (1 + bf.SLIP) / df) + 1
+    expected = np.log(m_eff) + 3 * np.log(2) + bf._log_gamma_sf(60.0 + 1e-9 * 120, 3)
+    assert res["logp"] == pytest.approx(expected, abs=1e-6)
+
+
+def test_a_line_counts_for_one_family_only(rng):
+    # 4 x BPFO (14.34 X) lies inside the window of 3 x 2xBSF (14.14 X, +-2 %): once the outer race has
+    # claimed its harmonics, that line is no evidence for a ball fault
+    freqs = B6205.frequencies(F1)
+    df = 0.1
+    r = rng.exponential(size=12000)
+    for h in range(1, 7):
+        r[int(round(h * freqs["BPFO"] / df))] = 200.0
+    ses = _ses(r, df)
+    bf._explain(ses, freqs, F1, F1, True, 9)
+    assert ses.primary == "bearing_outer_race"
+    ball = ses.results["bearing_ball"]
+    assert not bf._accepted(ball)
+    # the slip search may end elsewhere; wherever it ends, the claimed line itself reads as nothing
+    assert all(ln["r"] < 200.0 for ln in ball["lines"])
+    assert ses.r[int(round(4 * freqs["BPFO"] / df))] == 0.0
+
+
+def test_inner_race_needs_its_shaft_sidebands(rng):
+    freqs = B6205.frequencies(F1)
+    df = 0.1
+    base = rng.exponential(size=12000)
+    bare = base.copy()
+    for h in (1, 2, 3):
+        bare[int(round(h * freqs["BPFI"] / df))] = 100.0
+    ses = _ses(bare.copy(), df)
+    bf._explain(ses, freqs, F1, F1, True, 9)
+    assert ses.results["bearing_inner_race"]["modulation"] == 0 and ses.primary is None
+    modulated = bare.copy()
+    for h in (1, 2, 3):
+        for s in (-1, 1):
+            modulated[int(round((h * freqs["BPFI"] + s * F1) / df))] = 30.0
+    ses = _ses(modulated, df)
+    bf._explain(ses, freqs, F1, F1, True, 9)
+    assert ses.primary == "bearing_inner_race" and ses.results["bearing_inner_race"]["modulation"] == 6
+
+
+@pytest.mark.parametrize("kw,bearing,ok", [
+    (dict(fault="none", cage_modulation=1.0), "6205-2RS", {"none"}),
+    (dict(fault="bearing_outer_race", cage_modulation=1.0), "6205-2RS", {"bearing_outer_race"}),
+    (dict(fault="none", shaft_impacts=1.0, bearing="6203-2RS"), "6203-2RS", {"none", "looseness"}),
+    (dict(fault="none", shaft_impacts=3.0, bearing="6203-2RS"), "6203-2RS", {"none", "looseness"}),
+], ids=["cage-modulation-is-no-fault", "outer-race-beside-cage-comb", "shaft-harmonics-near-2xBSF",
+        "strong-shaft-impacts"])
+def test_stress_cases(kw, bearing, ok):
+    # the cage comb is claimed (reported, not called); shaft harmonics are claimed before any bearing
+    # family, so 4X (2xBSF of the 6203 is 3.99X) is never ball evidence
+    for seed in range(2):
+        d = vm.diagnose(vm.synth.machine(snr_db=0, seed=50 + seed, duration=6.0, **kw), bearing=bearing)
+        assert d.top in ok, d.reason
+        if kw.get("cage_modulation"):
+            cage = d.faults.set_index("fault").loc["bearing_cage"]
+            assert cage.p_value < 1e-6 and cage.confidence == 0.0 and "not a fault by itself" in cage.note
+
+
+# --- real recordings -----------------------------------------------------------------------------------
+
+TRUTH = {"I": "bearing_inner_race", "O": "bearing_outer_race", "B": "bearing_ball"}
+
+
+@pytest.fixture(scope="module")
+def development_set():
+    """Every record of cwru_fe/ and mfpt/ through vm.diagnose (about 15 s)."""
+    from tests.conftest import SHARED
+    import os
+    if not (SHARED / "cwru_fe").exists():
+        if os.environ.get("CI"):
+            pytest.fail("shared data cwru_fe/ is missing under CI")
+        pytest.skip("shared data not present")
+    out = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        for f in sorted((SHARED / "cwru_fe").glob("*.mat")):
+            rec = vm.read(f, fs=12000, unit="g")
+            fe = next(n for n in rec.names if n.endswith("_FE_time"))
+            out[f.name] = (TRUTH[f.name[0]], vm.diagnose(rec, bearing="6203-2RS", channel=fe))
+        for f in sorted((SHARED / "mfpt").glob("*.mat")):
+            rate = float(sio.loadmat(f, squeeze_me=True)["bearing"]["rate"].item())
+            rec = vm.read(f, channels=["bearing.gs"], unit="g")
+            out[f.name] = (TRUTH[f.name[0]], vm.diagnose(rec, rpm=60 * rate, bearing="MFPT"))
+    return out
+
+
+def test_development_set_scores(development_set):
+    # measured when this test was written: 39 right, 13 none, 1 wrong of 53 (benchmarks/diagnosis_real.py);
+    # the test guards the floor the issue sets for wrong calls and every inner race, and the level reached
+    right = sum(d.top == t for t, d in development_set.values())
+    wrong = sum(d.top != t and d.top != "none" for t, d in development_set.values())
+    assert len(development_set) == 53
+    assert wrong <= 2 and right >= 39
+    assert all(d.top == t for t, d in development_set.values() if t == "bearing_inner_race")
+
+
+@pytest.mark.parametrize("name", ["OR007@6_0.mat", "OR014@3_2.mat", "OR021@6_0.mat", "OuterRaceFault_vload_2.mat"])
+def test_outer_race_records_rest_on_a_bpfo_comb(development_set, name):
+    truth, d = development_set[name]
+    row = d.faults.set_index("fault").loc["bearing_outer_race"]
+    assert d.top == truth == "bearing_outer_race" and d.confidence > 0.8
+    assert row.p_value < 1e-10 and abs(row.slip) < 0.01
+    strong = [h for h in row.harmonics if h["sideband"] == 0 and h["db"] >= 7.8]
+    assert len(strong) >= 3  # at least three BPFO harmonics stand 7.8 dB above the floor
+    assert row.found_hz == pytest.approx(row.expected_hz, rel=0.01)
+
+
+@pytest.mark.parametrize("name", ["IR007_0.mat", "IR014_2.mat", "IR021_3.mat", "InnerRaceFault_vload_3.mat"])
+def test_inner_race_records_rest_on_bpfi_with_shaft_sidebands(development_set, name):
+    truth, d = development_set[name]
+    row = d.faults.set_index("fault").loc["bearing_inner_race"]
+    assert d.top == truth and row.p_value < 1e-10
+    side = [h for h in row.harmonics if h["sideband"] != 0 and h["db"] >= 7.8]
+    carriers = [h for h in row.harmonics if h["sideband"] == 0 and h["db"] >= 7.8]
+    assert len(side) >= 2 and len(carriers) >= 2
+
+
+def test_cwru_drive_end_fault_records_with_every_channel(shared_data):
+    # the drive-end records read whole (DE, FE, BA): evidence fused over the channels and named
+    ir = vm.diagnose(vm.read(shared_data("cwru/IR007_0.mat"), fs=12000, unit="g"), bearing="6205-2RS")
+    assert ir.top == "bearing_inner_race" and "X105" in ir.channel
+    row = ir.faults.set_index("fault").loc["bearing_inner_race"]
+    assert row.found_hz == pytest.approx(161.7, abs=0.8)  # the data README's strongest envelope line
+    orr = vm.diagnose(vm.read(shared_data("cwru/OR007_6_0.mat"), fs=12000, unit="g"), bearing="6205-2RS")
+    assert orr.top == "bearing_outer_race"
+    assert orr.faults.set_index("fault").loc["bearing_outer_race"].found_hz == pytest.approx(107.6, abs=0.8)
