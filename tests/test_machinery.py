@@ -133,3 +133,64 @@ def test_twice_line_frequency():
     d = vm.diagnose(rec, rpm=rpm, line_frequency=50.0)
     assert d.top == "electrical"
     assert vm.diagnose(rec, rpm=rpm).top != "electrical"  # without a line frequency there is no such check
+
+
+def test_without_a_bearing_the_answer_says_bearing_faults_were_not_checked(shared_data, tmp_path):
+    rec = cwru(shared_data, "IR")
+    d = vm.diagnose(rec)
+    assert not d.bearing_checked and "bearing_not_checked" in d.flags
+    assert "bearing faults not checked" in d.reason
+    assert not any(d.faults.fault.str.startswith("bearing"))
+    from tests.test_cli import run
+    code, out, _ = run(["diagnose", str(shared_data(CWRU["IR"][0])), "--fs", "12000", "--unit", "g"])
+    assert code == 0 and "bearing faults NOT CHECKED" in out
+
+
+def test_bearing_catalogue():
+    from vibmeasure.models.bearing import bearing_from
+    # the MFPT rig's bearing against the fault frequencies stored in its own files at 25 Hz
+    f = vm.BEARINGS["MFPT"].frequencies(25.0)
+    assert f["BPFO"] == pytest.approx(81.125, abs=0.01) and f["BPFI"] == pytest.approx(118.875, abs=0.01)
+    # (the files' FTF, 14.84 Hz, is (1 + d/D) / 2 x shaft: the cage speed relative to the inner race; with
+    # the outer race fixed the cage turns at (1 - d/D) / 2 x shaft)
+    assert f["FTF"] == pytest.approx(25.0 * (1 - 0.235 / 1.245) / 2, rel=1e-12)
+    # nominal 6205 against the CWRU rig's SKF 6205-2RS JEM: same balls, geometry within 0.5 %
+    o_nom, o_rig = vm.BEARINGS["6205"].orders(), vm.BEARINGS["6205-2RS"].orders()
+    assert o_nom["BPFO"] == pytest.approx(o_rig["BPFO"], rel=0.005)
+    assert bearing_from("6308-2Z C3") is vm.BEARINGS["6308"] and bearing_from("mfpt") is vm.BEARINGS["MFPT"]
+    assert bearing_from("6205-2RS") is vm.BEARINGS["6205-2RS"]  # the rig bearing, not the nominal one
+    assert "nominal" in vm.BEARINGS["6310"].name and len(vm.BEARINGS) >= 30
+    with pytest.raises(vm.ParameterError, match="not in the catalogue"):
+        bearing_from("NU2205")
+    with pytest.raises(vm.ParameterError, match="vm.Bearing or a catalogue name"):
+        bearing_from(6205)
+
+
+def test_every_channel_is_searched_and_the_evidence_is_named(shared_data):
+    rec = vm.read(shared_data("cwru_fe/OR007@6_0.mat"), fs=12000, unit="g")
+    both = vm.diagnose(rec, bearing="6203-2RS")
+    assert both.top == "bearing_outer_race" and both.bearing_checked
+    fe_only = vm.diagnose(rec, bearing="6203-2RS", channel="X294_FE_time", channels=["X294_FE_time"])
+    assert fe_only.top == "bearing_outer_race" and fe_only.channel == "X294_FE_time"
+    row = fe_only.faults.set_index("fault").loc["bearing_outer_race"]
+    assert row.channel == "X294_FE_time" and row.preprocessing.startswith("cepstral")
+    assert row.found_hz == pytest.approx(91.8, abs=0.3)   # the issue's BPFO line (expected 91.3)
+    doc = fe_only.to_dict()
+    json.dumps(doc, allow_nan=False)
+    assert doc["channel"] == "X294_FE_time" and doc["bearing_checked"] is True
+    bearing_rows = [r for r in doc["faults"] if r["fault"] == "bearing_outer_race"]
+    assert bearing_rows[0]["p_value"] < 1e-10 and len(bearing_rows[0]["harmonics"]) == 5
+
+
+def test_plot_diagnosis_shows_ses_comb_and_kurtogram(shared_data, tmp_path):
+    import matplotlib
+    matplotlib.use("Agg")
+    from vibmeasure.plot import plot_diagnosis
+    rec = vm.read(shared_data("cwru_fe/OR007@6_0.mat"), fs=12000, unit="g", channels=["X294_FE_time"])
+    d = vm.diagnose(rec, bearing="6203-2RS")
+    ax_e, ax_s, ax_g, ax_k = plot_diagnosis(rec, d)
+    assert "outer_race comb" in ax_e.get_title(loc="left") and "slip" in ax_e.get_title(loc="left")
+    assert len(ax_e.lines) >= 5 + 1  # the SES and at least the five BPFO harmonics
+    assert ax_k.images and "kurtogram" in ax_k.get_title()
+    ax_e.figure.savefig(tmp_path / "d.png")
+    assert (tmp_path / "d.png").stat().st_size > 10_000
