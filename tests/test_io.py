@@ -64,7 +64,10 @@ def test_csv_non_uniform_time_column(tmp_path):
 
 def test_csv_truncated_and_garbage(tmp_path):
     p = tmp_path / "trunc.csv"
-    p.write_text("time,a,b\n0,1,2\n0.1,3,4\n0.2,5")
+    p.write_text("time,a,b\n0,1,2\n0.1,3,4\n0.2,5")   # cut inside the last line: dropped, said so
+    with pytest.warns(vm.QualityWarning, match="no end of line"):
+        assert vm.read(p).n_samples == 2
+    p.write_text("time,a,b\n0,1,2\n0.1,3,4\n0.2,5\n")   # a short last row with its end of line: refused
     with pytest.raises(vm.ParameterError, match="truncated"):
         vm.read(p)
     g = tmp_path / "text.csv"

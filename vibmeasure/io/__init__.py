@@ -5,8 +5,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..core.errors import ParameterError
+from ..core.errors import ParameterError, UnitError
 from ..core.record import Record
+from ._common import DEFAULT_MAX_SAMPLES, check_max_samples
 from .csvfile import read_csv, write_csv
 from .hdf5 import read_hdf5, write_hdf5
 from .lazy import LazyRecord, open_record
@@ -24,7 +25,8 @@ FORMATS = tuple(sorted(_READERS))
 
 
 def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, quantity: str | None = None,
-         unit: str | None = None, dataset: str | None = None) -> Record:
+         unit: str | None = None, dataset: str | None = None, max_samples: int = DEFAULT_MAX_SAMPLES,
+         allow_external: bool = False) -> Record:
     """Read a measurement file into a :class:`Record`.
 
     The format follows the ending: .csv/.txt/.tsv, .h5/.hdf5, .wav, .mat (v5 and v7.3), .lvm.
@@ -32,6 +34,12 @@ def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, qua
     otherwise. ``channels`` selects columns/variables by name (dotted paths for MATLAB structs,
     ``"name[i]"`` for one row of a matrix) or position; ``quantity`` and ``unit`` label the data
     when the file does not. ``dataset`` names a bare dataset in a foreign HDF5 file.
+
+    Guarantees: a damaged, truncated or contradictory file raises ParameterError naming the file and
+    the rule (or, for a CSV whose last line has no end of line, drops that line with a QualityWarning);
+    a file declaring more than ``max_samples`` values is refused before anything is allocated; NaN,
+    inf and complex data are refused; HDF5 external storage and links that leave the file are refused
+    unless ``allow_external=True``.
     """
     p = Path(path)
     if not p.exists():
@@ -43,12 +51,28 @@ def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, qua
         raise ParameterError(f"path={str(path)!r}: unknown file type {ext!r}; readable: {FORMATS}")
     if p.stat().st_size == 0:
         raise ParameterError(f"path={str(path)!r} is empty (0 bytes)")
-    kw = dict(fs=fs, channels=channels, quantity=quantity, unit=unit)
-    if dataset is not None:
-        if ext not in (".h5", ".hdf5"):
-            raise ParameterError(f"dataset={dataset!r} applies to HDF5 files only, not {ext!r}")
-        kw["dataset"] = dataset
-    return _READERS[ext](p, **kw)
+    kw = dict(fs=fs, channels=channels, quantity=quantity, unit=unit, max_samples=check_max_samples(max_samples))
+    if ext in (".h5", ".hdf5"):
+        kw.update(dataset=dataset, allow_external=bool(allow_external))
+    elif dataset is not None:
+        raise ParameterError(f"dataset={dataset!r} applies to HDF5 files only, not {ext!r}")
+    return guarded(_READERS[ext], p, **kw)
+
+
+def guarded(reader, path, **kw):
+    """Run a reader; any failure inside h5py, scipy.io, pyuff, pandas or numpy parsing becomes a
+    ParameterError naming the file (a library's raw exception is never what the user sees)."""
+    try:
+        return reader(path, **kw)
+    except (ParameterError, UnitError):
+        raise
+    except MemoryError:
+        raise ParameterError(f"path={str(path)!r}: reading it needs more memory than is free; lower the data "
+                             "(channels=...) or stream it with vm.open") from None
+    except (ValueError, TypeError, KeyError, IndexError, ZeroDivisionError, UnboundLocalError, RecursionError,
+            OSError, EOFError, AttributeError, OverflowError, UnicodeError, LookupError, RuntimeError) as exc:
+        raise ParameterError(f"path={str(path)!r} is damaged or not a valid {Path(path).suffix} file "
+                             f"({type(exc).__name__}: {str(exc)[:200]})") from None
 
 
 def write(path: str | os.PathLike, obj) -> Path:
@@ -73,7 +97,7 @@ def read_frf(path: str | os.PathLike, *, variable: str | None = None, fs: float 
         raise ParameterError(f"path={str(path)!r} does not exist")
     ext = p.suffix.lower()
     if ext in (".uff", ".unv"):
-        return read_frf_uff(p)
+        return guarded(lambda q: read_frf_uff(q), p)
     if ext == ".mat":
         import numpy as np
         from .mat import _leaves_v5
@@ -104,4 +128,4 @@ def read_spectrum(path: str | os.PathLike):
         raise ParameterError(f"path={str(path)!r} does not exist")
     if p.suffix.lower() != ".lvm":
         raise ParameterError(f"path={str(path)!r}: spectra are read from LabVIEW .lvm exports, not {p.suffix!r}")
-    return read_lvm_spectrum(p)
+    return guarded(lambda q: read_lvm_spectrum(q), p)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +14,110 @@ from ..core import units as _units
 
 # relative spread of time steps accepted as uniform sampling
 TIME_STEP_RTOL = 1e-3
+# the most samples (channels x samples) a file may declare before anything is allocated: 2 GB of
+# float64; larger recordings are read with vm.open (streamed) or with a larger max_samples=
+DEFAULT_MAX_SAMPLES = 250_000_000
+MAX_CHANNELS = 10_000
+
+
+def check_max_samples(max_samples) -> int:
+    if isinstance(max_samples, bool) or not isinstance(max_samples, (int, np.integer)) or max_samples < 1:
+        raise ParameterError(f"max_samples={max_samples!r} must be a positive integer")
+    return int(max_samples)
+
+
+def check_size(n_values, *, source: str, max_samples: int, what: str = "data"):
+    """Refuse a declared size above the limit before it is allocated."""
+    if n_values > max_samples:
+        raise ParameterError(f"{source}: {what} declares {n_values:,} samples, above max_samples={max_samples:,} "
+                             "(about 8 bytes each in memory); raise max_samples= if the machine has the memory, "
+                             "or stream it with vm.open")
+
+
+def real_samples(x, *, source: str):
+    """Samples stored as complex with a zero imaginary part are real; any other complex data is refused
+    (a time record cannot hold its imaginary part, and dropping it would be a silent wrong number)."""
+    x = np.asarray(x)
+    if np.iscomplexobj(x):
+        if np.any(x.imag != 0):
+            raise ParameterError(f"{source}: the samples are complex with a non-zero imaginary part; a record holds "
+                                 "real samples (for FRFs use vm.read_frf)")
+        return x.real
+    return x
+
+
+def parse_number(value, *, source: str, key: str) -> float:
+    """A number stated in a file header ("10000", "1e4 Hz", "2048,5"), refusing what is ambiguous
+    ("1,000": thousands separator or decimal comma?), booleans and text."""
+    import re
+    if isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"{source}: {key} = {value!r} is a boolean, not a number")
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        v = float(value)
+    else:
+        txt = str(value).strip().strip('"').strip("'")
+        m = re.fullmatch(r"([-+]?[0-9][0-9.,]*(?:[eE][-+]?\d+)?)\s*(hz|s)?", txt, re.I)
+        if not m:
+            raise ParameterError(f"{source}: {key} = {value!r} is not a number")
+        num = m.group(1)
+        if "," in num:
+            if "." in num or re.fullmatch(r"[-+]?\d{1,3}(,\d{3})+", num):
+                raise ParameterError(f"{source}: {key} = {value!r} is ambiguous (thousands separator or decimal "
+                                     "comma?): write it without separators, e.g. 1000 or 1000.5")
+            num = num.replace(",", ".")
+        try:
+            v = float(num)
+        except ValueError:
+            raise ParameterError(f"{source}: {key} = {value!r} is not a number") from None
+    if not np.isfinite(v):
+        raise ParameterError(f"{source}: {key} = {value!r} is not finite")
+    return v
+
+
+def _check_target(path: Path) -> int | None:
+    """The mode of the regular file the write will replace (None for a new file); refuses a folder,
+    FIFO, device or socket at the output path, which a rename would silently replace."""
+    import stat
+    if not path.parent.exists():
+        raise ParameterError(f"path={str(path)!r}: folder {str(path.parent)!r} does not exist")
+    try:
+        st = path.stat()
+    except FileNotFoundError:
+        return None
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode)
+                else "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "a special file")
+        raise ParameterError(f"path={str(path)!r} is {kind}; the rule is: output goes to a regular file "
+                             "(it is never replaced by one)")
+    return stat.S_IMODE(st.st_mode)
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _clean_stale(path: Path):
+    """Remove the temporary files of writers of this path that were killed (their process is gone)."""
+    for tmp in path.parent.glob(f".{path.name}.*.part"):
+        parts = tmp.name[len(path.name) + 2:].split(".")
+        if parts and parts[0].isdigit() and int(parts[0]) != os.getpid() and not _pid_alive(int(parts[0])):
+            with contextlib.suppress(OSError):
+                tmp.unlink()
+
+
+def _fsync_dir(folder: Path):
+    with contextlib.suppress(OSError):
+        fd = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
 
 
 @contextlib.contextmanager
@@ -22,18 +125,33 @@ def atomic_path(path: str | os.PathLike):
     """Yield a temporary path beside ``path``; it replaces ``path`` only if the block succeeds.
 
     Nothing is half-written: on any error the temporary file is removed and ``path`` is untouched.
+    The data is flushed to disk (fsync) before the rename; a replaced file keeps its mode, a new one
+    gets the process's usual mode (no process-wide umask change); temporary files left by a killed
+    writer of the same path are removed. A folder, FIFO or device at ``path`` is refused.
     """
     path = Path(path)
-    if not path.parent.exists():
-        raise ParameterError(f"path={str(path)!r}: folder {str(path.parent)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    mode = _check_target(path)
+    _clean_stale(path)
+    fd, tmp = -1, ""
+    for _ in range(100):
+        tmp = str(path.parent / f".{path.name}.{os.getpid()}.{os.urandom(4).hex()}.part")
+        try:  # the kernel applies the umask to 0o666, as for any new file
+            fd = os.open(tmp, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666 if mode is None else mode)
+            break
+        except FileExistsError:
+            continue
     os.close(fd)
     try:
         yield Path(tmp)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a finished file gets the usual mode
+        if mode is not None:
+            os.chmod(tmp, mode)
+        fd = os.open(tmp, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
         os.replace(tmp, path)
+        _fsync_dir(path.parent)
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
@@ -79,9 +197,19 @@ def require_fs(fs, *, source: str) -> float:
 def make_record(data, fs, names, *, quantity=None, unit=None, quantities=None, units=None, t0=0.0,
                 meta=None, source="") -> Record:
     """Assemble a record; user-given quantity/unit override what the file says."""
+    data = np.asarray(data)
+    if np.iscomplexobj(data):
+        raise ParameterError(f"{source}: the data are complex; a record holds real samples (the imaginary part "
+                             "would be lost): read FRFs with vm.read_frf")
     data = np.asarray(data, dtype=np.float64)
     if data.ndim == 1:
         data = data[np.newaxis]
+    bad = ~np.isfinite(data)
+    if bad.any():
+        ch, i = np.unravel_index(int(np.argmax(bad)), data.shape)
+        raise ParameterError(f"{source}: channel {str(names[ch])!r} has {int(bad.sum())} NaN/inf value(s) (first at "
+                             f"sample {i}: {data[ch, i]!r}); the rule is finite samples (inf or overflowing numbers "
+                             "such as 1e999 too): repair the file or cut the record")
     n = data.shape[0]
     quantities = list(quantities or ["unknown"] * n)
     units = list(units or [""] * n)

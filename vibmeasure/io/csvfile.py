@@ -11,7 +11,8 @@ import numpy as np
 from ..core.errors import ParameterError
 from ..core.record import Record
 from ..core._validate import select_names
-from ._common import atomic_path, fs_from_time, make_record, require_fs
+from ._common import (DEFAULT_MAX_SAMPLES, MAX_CHANNELS, atomic_path, check_size, fs_from_time, make_record,
+                      parse_number, require_fs)
 
 _FS_KEYS = ("fs", "fs_hz", "sampling_rate", "sample_rate", "samplerate", "sampling_frequency")
 _TIME_NAMES = ("time", "t", "zeit", "seconds", "time_s", "timestamp")
@@ -39,14 +40,29 @@ def _sniff(lines: list[str]) -> tuple[str, str]:
     return sep, decimal
 
 
-def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None) -> Record:
+def _cut_last_line(text: str, src: str) -> str:
+    """A file whose last line has no end of line may have been cut inside that line (its last number
+    shortened): the line is dropped with a QualityWarning naming it."""
+    if not text or text.endswith(("\n", "\r")):
+        return text
+    head, _, last = text.rpartition("\n")
+    if last.strip() and not last.lstrip().startswith("#"):
+        import warnings
+        from ..core.errors import QualityWarning
+        warnings.warn(f"{src}: the last line {last[:60]!r} has no end of line (a cut file?); it was left out",
+                      QualityWarning, stacklevel=4)
+        return head + "\n"
+    return text
+
+
+def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
     import pandas as pd
     src = f"CSV file {str(path)!r}"
     try:
         text = Path(path).read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise ParameterError(f"{src} is not UTF-8 text: unreadable as CSV") from None
-    lines = text.splitlines()
+    lines = _cut_last_line(text, src).splitlines()
     header_kv: dict[str, str] = {}
     chan_meta: dict[str, tuple[str, str]] = {}
     body = []
@@ -69,6 +85,10 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
         raise ParameterError(f"{src} has no data rows")
     sep, decimal = _sniff(body[1:] if len(body) > 1 else body)
     first = body[0].split(sep)
+    if len(first) > MAX_CHANNELS:
+        raise ParameterError(f"{src}: its first row has {len(first):,} fields, above the limit of {MAX_CHANNELS:,} "
+                             "channels")
+    check_size(len(first) * len(body), source=src, max_samples=max_samples)
     has_header = any(not _is_number(f, decimal) for f in first if f.strip())
     if sep == "," and decimal == "." and has_header and len(body) > 1:
         # a decimal comma with a comma separator cannot be told apart: reject clearly
@@ -105,13 +125,12 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
         units.append(un)
     tcol = next((i for i, n in enumerate(names) if n.lower() in _TIME_NAMES), None)
     t0 = 0.0
-    file_fs = None
-    for k in _FS_KEYS:
-        if k in header_kv:
-            try:
-                file_fs = float(header_kv[k].split()[0].replace(",", "."))
-            except ValueError:
-                raise ParameterError(f"{src}: header {k} = {header_kv[k]!r} is not a number") from None
+    stated = {k: parse_number(header_kv[k], source=src, key=f"header {k}") for k in _FS_KEYS if k in header_kv}
+    if len(set(stated.values())) > 1:
+        raise ParameterError(f"{src}: the header states two sampling rates {stated}: which one is right?")
+    file_fs = next(iter(stated.values()), None)
+    if file_fs is not None and file_fs <= 0:
+        raise ParameterError(f"{src}: header fs = {file_fs:g} must be > 0 Hz")
     if tcol is not None:
         tscale = {"ms": 1e-3, "us": 1e-6, "s": 1.0, None: 1.0, "": 1.0}.get(units[tcol], None)
         if tscale is None:
@@ -126,7 +145,7 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
             raise ParameterError(f"fs={fs:g} contradicts {src}, whose timing gives {file_fs:g} Hz")
     fs = file_fs if file_fs is not None else require_fs(fs, source=src)
     if "t0_s" in header_kv:
-        t0 = float(header_kv["t0_s"])
+        t0 = parse_number(header_kv["t0_s"], source=src, key="header t0_s")
     data_cols = [i for i in range(len(names)) if i != tcol]
     if not data_cols:
         raise ParameterError(f"{src} has a time column but no data column")
@@ -141,7 +160,7 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
 
 
 def _is_number(s: str, decimal: str) -> bool:
-    s = s.strip()
+    s = s.strip().strip('"').strip("'")  # a quoted number is still a number, not a column label
     if decimal == ",":
         s = s.replace(",", ".")
     try:

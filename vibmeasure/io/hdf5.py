@@ -17,7 +17,7 @@ import numpy as np
 from ..core.errors import ParameterError
 from ..core.record import Channel, Record
 from ..core._validate import select_names
-from ._common import atomic_path, make_record, require_fs
+from ._common import DEFAULT_MAX_SAMPLES, atomic_path, check_size, make_record, parse_number, real_samples, require_fs
 
 SCHEMA = "vibmeasure.record"
 SCHEMA_VERSION = 1
@@ -35,7 +35,41 @@ def _str_list(a) -> list[str]:
     return [x.decode() if isinstance(x, bytes) else str(x) for x in np.atleast_1d(a)]
 
 
-def read_hdf5(path, *, fs=None, channels=None, quantity=None, unit=None, dataset=None) -> Record:
+def _dataset(f, name: str, src: str, *, allow_external: bool, max_samples: int):
+    """A dataset of the file, checked before anything is read: it must live in this file (no external
+    link, external raw storage or virtual mapping unless allowed), be numeric and within max_samples."""
+    import h5py
+    lk = f.get(name, getlink=True)
+    if lk is None:
+        raise ParameterError(f"dataset={name!r} is not in {src}")
+    if isinstance(lk, h5py.ExternalLink) and not allow_external:
+        raise ParameterError(f"{src}: {name!r} is an external link to {lk.filename!r}:{lk.path!r}; links that "
+                             "leave the file are refused (allow_external=True if you trust the file)")
+    try:
+        d = f[name]
+    except KeyError as exc:
+        raise ParameterError(f"{src}: {name!r} is a dangling link ({exc})") from None
+    if not isinstance(d, h5py.Dataset):
+        raise ParameterError(f"{src}: {name!r} is a group, not a dataset")
+    if not allow_external:
+        if d.file.filename != f.filename:
+            raise ParameterError(f"{src}: {name!r} resolves into another file ({d.file.filename!r}); refused "
+                                 "(allow_external=True if you trust the file)")
+        if d.external:
+            raise ParameterError(f"{src}: {name!r} keeps its samples in external raw files "
+                                 f"{[e[0] for e in d.external]}: any local file could be read as samples; refused "
+                                 "(allow_external=True if you trust the file)")
+        if d.is_virtual:
+            raise ParameterError(f"{src}: {name!r} is a virtual dataset mapping other files; refused "
+                                 "(allow_external=True if you trust the file)")
+    if d.dtype.kind not in "fiuc":
+        raise ParameterError(f"{src}: {name!r} holds {d.dtype} values, not numbers")
+    check_size(int(np.prod(d.shape, dtype=np.float64)), source=src, max_samples=max_samples, what=f"dataset {name!r}")
+    return d
+
+
+def read_hdf5(path, *, fs=None, channels=None, quantity=None, unit=None, dataset=None, allow_external=False,
+              max_samples=DEFAULT_MAX_SAMPLES) -> Record:
     src = f"HDF5 file {str(path)!r}"
     with _open(path) as f:
         schema = f.attrs.get("vibmeasure_schema")
@@ -44,18 +78,21 @@ def read_hdf5(path, *, fs=None, channels=None, quantity=None, unit=None, dataset
             ver = int(f.attrs.get("schema_version", -1))
             if ver > SCHEMA_VERSION:
                 raise ParameterError(f"{src} has schema_version {ver}; this vibmeasure reads up to {SCHEMA_VERSION}")
+            d = _dataset(f, "data", src, allow_external=allow_external, max_samples=max_samples)
             try:
-                d = f["data"]
-                data = d[()]
+                data = real_samples(d[()], source=src)
                 a = d.attrs
                 chans = [Channel(n, q, u, loc) for n, q, u, loc in zip(
                     _str_list(a["channel_names"]), _str_list(a["channel_quantities"]),
                     _str_list(a["channel_units"]), _str_list(a["channel_locations"]))]
-                rfs, t0 = float(a["fs"]), float(a["t0"])
+                rfs = parse_number(a["fs"], source=src, key="attribute fs")
+                t0 = parse_number(a["t0"], source=src, key="attribute t0")
                 meta = json.loads(f.attrs.get("meta", "{}"))
                 history = tuple(json.loads(f.attrs.get("history", "[]")))
-            except (KeyError, OSError, ValueError) as exc:
+            except (KeyError, OSError, ValueError, TypeError) as exc:
                 raise ParameterError(f"{src} claims schema {SCHEMA} but is damaged: {exc}") from None
+            if len({len(chans), data.shape[0] if data.ndim == 2 else -1}) != 1:
+                raise ParameterError(f"{src}: data has shape {data.shape} but {len(chans)} channel descriptions")
             if fs is not None and float(fs) != rfs:
                 raise ParameterError(f"fs={fs} contradicts {src}, which stores fs={rfs}")
             rec = Record(data, rfs, tuple(chans), t0=t0, meta=meta, history=history)
@@ -74,14 +111,16 @@ def read_hdf5(path, *, fs=None, channels=None, quantity=None, unit=None, dataset
                 raise ParameterError(f"{src} is not a vibmeasure record file; name the dataset "
                                      f"(dataset=...) among {names}")
             dataset = names[0]
-        if dataset not in f:
-            raise ParameterError(f"dataset={dataset!r} is not in {src}")
-        d = f[dataset]
+        d = _dataset(f, dataset, src, allow_external=allow_external, max_samples=max_samples)
         try:
-            data = np.asarray(d[()], dtype=np.float64)
+            data = real_samples(d[()], source=f"{src} dataset {dataset!r}")
         except (OSError, TypeError, ValueError) as exc:
             raise ParameterError(f"{src}: dataset {dataset!r} is unreadable: {exc}") from None
-        attr_fs = next((float(d.attrs[k]) for k in ("fs", "sampling_rate", "fs_hz") if k in d.attrs), None)
+        if data.ndim not in (1, 2) or data.size < 2:
+            raise ParameterError(f"{src}: dataset {dataset!r} has shape {data.shape}; a record is 1-D or "
+                                 "(channels, samples)")
+        attrs = [k for k in ("fs", "sampling_rate", "fs_hz") if k in d.attrs]
+        attr_fs = parse_number(d.attrs[attrs[0]], source=src, key=f"attribute {attrs[0]}") if attrs else None
         fs = attr_fs if fs is None and attr_fs is not None else require_fs(fs, source=f"{src} dataset {dataset!r}")
     if data.ndim == 1:
         data = data[np.newaxis]

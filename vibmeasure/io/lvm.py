@@ -11,12 +11,12 @@ from ..core.errors import ParameterError, UnitError
 from ..core import units as _units
 from ..core.record import Record
 from ..core._validate import select_names
-from ._common import make_record, require_fs
+from ._common import DEFAULT_MAX_SAMPLES, check_size, make_record, parse_number, require_fs
 
 _END = "***End_of_Header***"
 
 
-def read_lvm(path, *, fs=None, channels=None, quantity=None, unit=None) -> Record:
+def read_lvm(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
     import pandas as pd
     src = f"LVM file {str(path)!r}"
     try:
@@ -47,9 +47,18 @@ def read_lvm(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
         if body_start < len(lines) and lines[body_start].startswith("X_Value"):
             names = [p.strip() for p in lines[body_start].split(sep)]
             body_start += 1
-    body = "\n".join(ln for ln in lines[body_start:] if ln.strip())
-    if not body:
+    rows = [ln for ln in lines[body_start:] if ln.strip()]
+    if not rows:
         raise ParameterError(f"{src} has no data rows")
+    check_size(len(rows) * (rows[0].count(sep) + 1), source=src, max_samples=max_samples)
+    if not text.endswith(("\n", "\r")):
+        raise ParameterError(f"{src}: the last line {rows[-1][:60]!r} has no end of line: the file was cut "
+                             "(LabVIEW ends every line)")
+    stated = [parse_number(v, source=src, key="header Samples") for v in header.get("Samples", [])]
+    if stated and any(v != len(rows) for v in stated):
+        raise ParameterError(f"{src}: the header states {int(max(stated))} samples per channel but the file holds "
+                             f"{len(rows)} rows (truncated file?)")
+    body = "\n".join(rows)
     try:
         df = pd.read_csv(io.StringIO(body), sep=sep, header=None, decimal=dec, engine="c")
     except Exception as exc:
@@ -72,11 +81,14 @@ def read_lvm(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
             raise ParameterError(f"{src} holds a spectrum ({ychan[0]!r}: its X column is frequency), not a "
                                  "time record; vm.read reads time records")
         if "Delta_X" in header:
-            dx = float(header["Delta_X"][0].replace(",", "."))
+            steps = {parse_number(v, source=src, key="header Delta_X") for v in header["Delta_X"]}
+            if len(steps) > 1:
+                raise ParameterError(f"{src}: the header states different Delta_X per channel {sorted(steps)}")
+            dx = steps.pop()
             if dx <= 0:
                 raise ParameterError(f"{src}: Delta_X={dx} must be > 0")
             file_fs = 1.0 / dx
-            t0 = float((header.get("X0") or ["0"])[0].replace(",", "."))
+            t0 = parse_number((header.get("X0") or ["0"])[0], source=src, key="header X0")
         ulab = (header.get("Y_Unit_Label") or [""])[0]
         try:
             file_unit = _units.normalize_unit(ulab)

@@ -14,16 +14,20 @@ import numpy as np
 
 from ..core.errors import ParameterError
 from ..core.record import Record
-from ._common import fs_from_time, make_record, require_fs
+from ._common import DEFAULT_MAX_SAMPLES, check_size, fs_from_time, make_record, parse_number, require_fs
 
 _TIME_LEAF = re.compile(r"^(time|t|time_domain|timevector|tvec|time_s)$", re.I)
 _FS_LEAF = re.compile(r"^(fs|sr|samplerate|sample_rate|sampling_rate|samplingrate|.*_sample_rate|fsamp)$", re.I)
 _RPM_LEAF = re.compile(r".*rpm$", re.I)
 
 
-def _leaves_v5(path) -> dict[str, np.ndarray]:
+def _leaves_v5(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
     import scipy.io as sio
     try:
+        if max_samples is not None:  # the declared sizes, before any variable is decompressed
+            for name, shape, _cls in sio.whosmat(path):
+                check_size(int(np.prod(shape, dtype=np.float64)), source=f"MAT file {str(path)!r}",
+                           max_samples=max_samples, what=f"variable {name!r}")
         raw = sio.loadmat(path, squeeze_me=False, struct_as_record=True)
     except NotImplementedError:
         raise _V73() from None
@@ -51,7 +55,7 @@ class _V73(Exception):
     pass
 
 
-def _leaves_v73(path) -> dict[str, np.ndarray]:
+def _leaves_v73(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
     import h5py
     try:
         f = h5py.File(path, "r")
@@ -59,11 +63,22 @@ def _leaves_v73(path) -> dict[str, np.ndarray]:
         raise ParameterError(f"MAT file {str(path)!r} is unreadable (truncated, or v7.3 damaged): {exc}") from None
     out: dict[str, np.ndarray] = {}
     with f:
+        skip: list[str] = []
+
         def visit(name, obj):
-            if name.startswith("#refs#") or not isinstance(obj, h5py.Dataset):
+            if isinstance(obj, h5py.Group) and obj.attrs.get("MATLAB_sparse") is not None:
+                skip.append(name + "/")   # a sparse matrix: its data/ir/jc parts are no signals
+            if name.startswith("#refs#") or not isinstance(obj, h5py.Dataset) or name.startswith(tuple(skip)):
                 return
+            cls = obj.attrs.get("MATLAB_class")
+            cls = cls.decode() if isinstance(cls, bytes) else cls
+            if cls in ("char", "logical", "cell", "struct") or obj.attrs.get("MATLAB_empty"):
+                return                    # text, flags and empty variables are no signals
             if obj.dtype.kind not in "fiucb" and not obj.dtype.names:
                 return
+            if max_samples is not None:
+                check_size(int(np.prod(obj.shape, dtype=np.float64)), source=f"MAT file {str(path)!r}",
+                           max_samples=max_samples, what=f"variable {name!r}")
             a = obj[()]
             if a.dtype.names and set(a.dtype.names) >= {"real", "imag"}:
                 a = a["real"] + 1j * a["imag"]
@@ -81,12 +96,12 @@ def _signal_rows(a: np.ndarray) -> np.ndarray | None:
     return a if a.shape[1] >= a.shape[0] else a.T
 
 
-def read_mat(path, *, fs=None, channels=None, quantity=None, unit=None) -> Record:
+def read_mat(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
     src = f"MAT file {str(path)!r}"
     try:
-        leaves = _leaves_v5(path)
+        leaves = _leaves_v5(path, max_samples)
     except _V73:
-        leaves = _leaves_v73(path)
+        leaves = _leaves_v73(path, max_samples)
     if not leaves:
         raise ParameterError(f"{src} holds no numeric variables")
     scalars = {k: v for k, v in leaves.items() if np.asarray(v).size == 1}
@@ -138,10 +153,13 @@ def read_mat(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
 
     # the sampling rate
     file_fs, t0 = None, 0.0
-    for k, v in scalars.items():
-        if _FS_LEAF.match(k.split(".")[-1]):
-            file_fs = float(np.asarray(v).ravel()[0])
-            break
+    stated = {k: parse_number(np.asarray(v).ravel()[0].item(), source=src, key=f"variable {k}")
+              for k, v in scalars.items() if _FS_LEAF.match(k.split(".")[-1])}
+    if len(set(stated.values())) > 1:
+        raise ParameterError(f"{src} states two sampling rates {stated}: which one is right?")
+    file_fs = next(iter(stated.values()), None)
+    if file_fs is not None and file_fs <= 0:
+        raise ParameterError(f"{src}: sampling rate {file_fs:g} must be > 0 Hz")
     if file_fs is None:
         prefix = names[0].split("[")[0].rsplit(".", 1)[0]
         tkeys = sorted((k for k, r in times.items() if r.shape[1] == n),

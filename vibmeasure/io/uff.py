@@ -12,12 +12,25 @@ from ..core.errors import ParameterError, UnitError
 from ..core import units as _units
 from ..core.record import Record
 from ..core._validate import select_names
-from ._common import make_record
+from ._common import DEFAULT_MAX_SAMPLES, check_size, make_record, real_samples
 
 _QUANTITY = {8: "displacement", 11: "velocity", 12: "acceleration", 9: "force", 13: "force"}
 
 
+def _check_complete(path):
+    """Every UFF dataset ends with a line "    -1": a file cut inside its last dataset does not."""
+    with open(path, "rb") as fh:
+        fh.seek(0, 2)
+        size = fh.tell()
+        fh.seek(max(0, size - 64))
+        tail = fh.read()
+    if not tail.rstrip().endswith(b"-1"):
+        raise ParameterError(f"UFF file {str(path)!r} does not end with the dataset delimiter -1: the file was "
+                             "cut inside its last dataset")
+
+
 def _sets(path):
+    _check_complete(path)
     try:
         import pyuff
     except ImportError:
@@ -45,7 +58,7 @@ def _unit(label, quantity):
         return ""
 
 
-def read_uff(path, *, fs=None, channels=None, quantity=None, unit=None) -> Record:
+def read_uff(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
     src = f"UFF file {str(path)!r}"
     sets = _sets(path)
     time_sets = [d for d in sets if int(d.get("func_type", 0)) == 1]
@@ -54,6 +67,11 @@ def read_uff(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
         raise ParameterError(f"{src} holds no time response (function types {kinds}); FRFs (type 4) are read "
                              "with vm.read_frf")
     n = {int(d["num_pts"]) for d in time_sets}
+    check_size(max(n) * len(time_sets), source=src, max_samples=max_samples)
+    for d in time_sets:
+        if np.asarray(d["data"]).size != int(d["num_pts"]):
+            raise ParameterError(f"{src}: a dataset states {int(d['num_pts'])} points but holds "
+                                 f"{np.asarray(d['data']).size} (truncated file?)")
     dx = {float(d["abscissa_inc"]) for d in time_sets}
     if len(n) != 1 or len(dx) != 1:
         raise ParameterError(f"{src}: its time datasets differ in length {sorted(n)} or step {sorted(dx)}")
@@ -66,7 +84,7 @@ def read_uff(path, *, fs=None, channels=None, quantity=None, unit=None) -> Recor
         while name in names:
             name += "'"
         names.append(name)
-        data.append(np.real(np.asarray(d["data"])).astype(np.float64))
+        data.append(real_samples(d["data"], source=f"{src} dataset {name!r}"))
         q = _QUANTITY.get(int(d.get("ordinate_spec_data_type", 0)), "unknown")
         qs.append(q)
         us.append(_unit(d.get("ordinate_axis_units_lab", ""), q))

@@ -10,23 +10,26 @@ import numpy as np
 from ..core.errors import ParameterError
 from ..core.record import Record
 from ..core._validate import select_names
-from ._common import atomic_path, make_record
+from ._common import DEFAULT_MAX_SAMPLES, atomic_path, check_size, make_record
 
 _FULL_SCALE = {np.dtype("int16"): 32768.0, np.dtype("int32"): 2147483648.0, np.dtype("uint8"): 128.0}
 
 
-def read_wav(path, *, fs=None, channels=None, quantity=None, unit=None) -> Record:
+def read_wav(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
     from scipy.io import wavfile
     src = f"WAV file {str(path)!r}"
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", wavfile.WavFileWarning)
-            rate, data = wavfile.read(path)
+            rate, data = wavfile.read(path, mmap=True)  # mapped, not loaded: sizes are checked first
     except (ValueError, EOFError, OSError, struct.error, wavfile.WavFileWarning) as exc:
         raise ParameterError(f"{src} is unreadable (truncated or not WAV): {exc}") from None
+    check_size(data.size, source=src, max_samples=max_samples)
+    if data.dtype.kind not in "iuf":
+        raise ParameterError(f"{src}: sample type {data.dtype} is not PCM integer or float")
     if fs is not None and float(fs) != float(rate):
         raise ParameterError(f"fs={fs} contradicts {src}, recorded at {rate} Hz")
-    data = np.asarray(data)
+    data = np.array(data)  # out of the file mapping
     scale = _FULL_SCALE.get(data.dtype)
     x = data.astype(np.float64)
     if data.dtype == np.uint8:
