@@ -95,7 +95,8 @@ def test_hdf5_round_trip_exact_with_schema(tmp_path, rec2):
     assert vm.read(p) == rec2  # data, fs, t0, channels, meta and history all equal
     with h5py.File(p) as f:
         assert f.attrs["vibmeasure_schema"] == "vibmeasure.record"
-        assert int(f.attrs["schema_version"]) == 1
+        assert int(f.attrs["schema_version"]) == 2
+    assert open(p, "rb").read(23) == b"VIBMEASURE-SEAL-SHA256 "  # sealed: SHA-256 in the user block
 
 
 def test_hdf5_bare_dataset_needs_fs(tmp_path):
@@ -121,6 +122,10 @@ def test_hdf5_newer_schema_refused(tmp_path, rec2):
     p = vm.write(tmp_path / "r.h5", rec2)
     with h5py.File(p, "a") as f:
         f.attrs["schema_version"] = 99
+    with pytest.raises(vm.ParameterError, match="does not match the SHA-256"):
+        vm.read(p)  # edited after writing: the seal no longer matches
+    from vibmeasure.io.hdf5 import seal
+    seal(p)  # as a newer vibmeasure would have written it
     with pytest.raises(vm.ParameterError, match="schema_version 99"):
         vm.read(p)
 

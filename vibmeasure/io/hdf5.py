@@ -20,11 +20,57 @@ from ..core._validate import select_names
 from ._common import DEFAULT_MAX_SAMPLES, atomic_path, check_size, make_record, parse_number, real_samples, require_fs
 
 SCHEMA = "vibmeasure.record"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2   # 2: the file is sealed (SHA-256 in the HDF5 user block); 1 is still read
+
+USERBLOCK = 512
+_MAGIC = b"VIBMEASURE-SEAL-SHA256 "
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def _digest(path, start: int = USERBLOCK) -> str:
+    import hashlib
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        fh.seek(start)
+        for block in iter(lambda: fh.read(1 << 22), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def seal(path) -> None:
+    """Write the SHA-256 of everything after the user block into the user block, twice (a single
+    damaged byte leaves one copy readable). Call on a closed file made with userblock_size=512."""
+    line = _MAGIC + _digest(path).encode() + b"\n"
+    block = (line + b"\0" * (USERBLOCK // 2 - len(line))) * 2
+    with open(path, "r+b") as fh:
+        fh.write(block)
+
+
+def check_seal(path, src: str) -> bool:
+    """Before HDF5 parses a file: a file vibmeasure sealed must match its checksum, so a damaged
+    byte anywhere is a named error here instead of a crash, a hang or a silently changed number
+    inside the HDF5 library. Returns True for a verified file, False for an unsealed one."""
+    with open(path, "rb") as fh:
+        head = fh.read(USERBLOCK + len(_HDF5_SIGNATURE))
+    copies = [head[:USERBLOCK // 2], head[USERBLOCK // 2: USERBLOCK]]
+    ours = [c for c in copies if c.startswith(_MAGIC)]
+    looks_ours = ours or any(b"VIBMEASURE" in c or b"SEAL-SHA256" in c for c in copies)
+    if not looks_ours:
+        return False
+    if head[USERBLOCK:] != _HDF5_SIGNATURE:
+        raise ParameterError(f"{src} is damaged: its HDF5 signature after the seal is missing (truncated or "
+                             "overwritten)")
+    stated = {c[len(_MAGIC): len(_MAGIC) + 64] for c in ours}
+    actual = _digest(path).encode()
+    if actual not in stated:
+        raise ParameterError(f"{src} is damaged: its content does not match the SHA-256 vibmeasure wrote into it "
+                             "(a changed or cut byte; or the file was edited after writing)")
+    return True
 
 
 def _open(path):
     import h5py
+    check_seal(path, f"HDF5 file {str(path)!r}")
     try:
         return h5py.File(path, "r")
     except (OSError, ValueError) as exc:
@@ -134,7 +180,7 @@ def read_hdf5(path, *, fs=None, channels=None, quantity=None, unit=None, dataset
 def write_hdf5(path, rec: Record) -> None:
     import h5py
     with atomic_path(path) as tmp:
-        with h5py.File(tmp, "w") as f:
+        with h5py.File(tmp, "w", userblock_size=USERBLOCK) as f:
             f.attrs["vibmeasure_schema"] = SCHEMA
             f.attrs["schema_version"] = SCHEMA_VERSION
             f.attrs["meta"] = json.dumps(dict(rec.meta), default=str)
@@ -146,3 +192,4 @@ def write_hdf5(path, rec: Record) -> None:
             d.attrs["channel_quantities"] = [c.quantity for c in rec.channels]
             d.attrs["channel_units"] = [c.unit for c in rec.channels]
             d.attrs["channel_locations"] = [c.location for c in rec.channels]
+        seal(tmp)

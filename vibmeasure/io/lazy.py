@@ -111,6 +111,8 @@ def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: floa
     if p.suffix.lower() not in (".h5", ".hdf5"):
         raise ParameterError(f"path={str(path)!r}: vm.open reads HDF5 (.h5, .hdf5); use vm.read for {p.suffix!r}")
     import h5py
+    from .hdf5 import check_seal
+    check_seal(p, f"HDF5 file {str(path)!r}")
     try:
         f = h5py.File(p, "r")
     except (OSError, ValueError) as exc:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -136,9 +137,12 @@ class History:
         self.baseline_count = int(baseline_count)
         self.entries: list[tuple[float, ModalEstimate]] = []
 
-    def add(self, est: ModalEstimate, *, time: float) -> "History":
+    def add(self, est: ModalEstimate, *, time) -> "History":
+        """Append an estimate measured at ``time``: seconds (any epoch, e.g. Unix time), a datetime or a
+        pandas Timestamp (stored as Unix seconds, naive times taken as UTC). Times must increase."""
         if not isinstance(est, ModalEstimate):
             raise ParameterError(f"est must be a vm.ModalEstimate, got {type(est).__name__}")
+        time = _seconds(time)
         if self.entries and time <= self.entries[-1][0]:
             raise ParameterError(f"time={time} must increase (last entry at {self.entries[-1][0]})")
         self.entries.append((float(time), est))
@@ -192,11 +196,28 @@ class History:
 
     # --- storage ---------------------------------------------------------------------------------
     def save(self, path) -> None:
-        """Write to HDF5 (atomic): one group per entry with fn, zeta and their std."""
+        """Write to HDF5 (atomic, sealed with a checksum): one group per entry with fn, zeta and their
+        std. Entries another process saved to the same file meanwhile are kept: under an exclusive
+        lock the file is read again and merged (by time and values), so concurrent load-add-save loses
+        no update."""
+        with _locked(path):
+            if Path(path).is_file():
+                self._merge(History.load(path))
+            self._write(path)
+
+    def _merge(self, other: "History"):
+        def key(e):
+            t, m = e
+            return (t, m.method, tuple(np.round(m.fn, 12)), tuple(np.round(m.zeta, 15)))
+        seen = {key(e) for e in self.entries}
+        self.entries = sorted(self.entries + [e for e in other.entries if key(e) not in seen], key=lambda e: e[0])
+
+    def _write(self, path) -> None:
         import h5py
         from ..io._common import atomic_path
+        from ..io.hdf5 import USERBLOCK, seal
         with atomic_path(path) as tmp:
-            with h5py.File(tmp, "w") as f:
+            with h5py.File(tmp, "w", userblock_size=USERBLOCK) as f:
                 f.attrs["vibmeasure_schema"] = "vibmeasure.history"
                 f.attrs["schema_version"] = 1
                 f.attrs["name"] = self.name
@@ -208,10 +229,15 @@ class History:
                     g.attrs["flags"] = json.dumps(list(e.flags))
                     for k in ("fn", "zeta", "fn_std", "zeta_std"):
                         g[k] = getattr(e, k)
+            seal(tmp)
 
     @classmethod
     def load(cls, path) -> "History":
         import h5py
+        from ..io.hdf5 import check_seal
+        if not Path(path).is_file():
+            raise ParameterError(f"history file {str(path)!r} does not exist")
+        check_seal(path, f"history file {str(path)!r}")
         try:
             f = h5py.File(path, "r")
         except (OSError, ValueError) as exc:
@@ -219,10 +245,53 @@ class History:
         with f:
             if f.attrs.get("vibmeasure_schema") not in ("vibmeasure.history", b"vibmeasure.history"):
                 raise ParameterError(f"{str(path)!r} is not a vibmeasure history (baseline) file")
-            h = cls(str(f.attrs["name"]), baseline_count=int(f.attrs["baseline_count"]))
-            for key in sorted(f):
-                g = f[key]
-                h.entries.append((float(g.attrs["time"]), ModalEstimate(
-                    fn=g["fn"][()], zeta=g["zeta"][()], fn_std=g["fn_std"][()], zeta_std=g["zeta_std"][()],
-                    method=str(g.attrs["method"]), flags=tuple(json.loads(g.attrs["flags"])))))
+            try:
+                h = cls(str(f.attrs["name"]), baseline_count=int(f.attrs["baseline_count"]))
+                for key in sorted(f):
+                    g = f[key]
+                    h.entries.append((float(g.attrs["time"]), ModalEstimate(
+                        fn=g["fn"][()], zeta=g["zeta"][()], fn_std=g["fn_std"][()], zeta_std=g["zeta_std"][()],
+                        method=str(g.attrs["method"]), flags=tuple(json.loads(g.attrs["flags"])))))
+            except (KeyError, ValueError, TypeError, OSError, AttributeError) as exc:
+                raise ParameterError(f"history file {str(path)!r} is damaged ({type(exc).__name__}: {exc})") from None
         return h
+
+
+def _seconds(time) -> float:
+    """A time stamp as seconds: a number, a datetime (naive = UTC) or a pandas/numpy time stamp."""
+    import datetime as _dt
+    if isinstance(time, (bool, np.bool_)):
+        raise ParameterError(f"time={time!r} must be seconds or a datetime, not a boolean")
+    if isinstance(time, np.datetime64):
+        time = time.astype("datetime64[ns]").astype("int64") / 1e9
+    elif isinstance(time, _dt.datetime):  # pandas.Timestamp is a datetime too
+        if time.tzinfo is None:
+            time = time.replace(tzinfo=_dt.timezone.utc)
+        time = time.timestamp()
+    try:
+        t = float(time)
+    except (TypeError, ValueError):
+        raise ParameterError(f"time={time!r} must be seconds or a datetime") from None
+    if not np.isfinite(t):
+        raise ParameterError(f"time={time!r} must be finite")
+    return t
+
+
+class _locked:
+    """An exclusive lock on path + ".lock" (fcntl) for a read-modify-write of one file."""
+
+    def __init__(self, path):
+        self.lock = Path(str(path) + ".lock")
+
+    def __enter__(self):
+        import fcntl
+        if not self.lock.parent.exists():
+            raise ParameterError(f"path={str(self.lock)[:-5]!r}: folder {str(self.lock.parent)!r} does not exist")
+        self.fh = open(self.lock, "a")
+        fcntl.flock(self.fh, fcntl.LOCK_EX)
+        return self
+
+    def __exit__(self, *exc):
+        import fcntl
+        fcntl.flock(self.fh, fcntl.LOCK_UN)
+        self.fh.close()
