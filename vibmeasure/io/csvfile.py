@@ -55,6 +55,21 @@ def _cut_last_line(text: str, src: str) -> str:
     return text
 
 
+def _check_digest(text: str, src: str) -> None:
+    """A CSV vibmeasure wrote states the SHA-256 of its data rows: a changed digit is a named error."""
+    m = re.search(r"^#\s*sha256\s*=\s*([0-9a-f]{64})\s*$", text[:1 << 16], re.M)
+    if not m:
+        return
+    import hashlib
+    pos = 0
+    while pos < len(text) and text.startswith("#", pos):
+        nl = text.find("\n", pos)
+        pos = len(text) if nl < 0 else nl + 1
+    if hashlib.sha256(text[pos:].encode("utf-8")).hexdigest() != m.group(1):
+        raise ParameterError(f"{src} is damaged: its rows do not match the SHA-256 stated in its header (a changed, "
+                             "cut or edited file)")
+
+
 def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
     import pandas as pd
     src = f"CSV file {str(path)!r}"
@@ -62,6 +77,7 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
         text = Path(path).read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise ParameterError(f"{src} is not UTF-8 text: unreadable as CSV") from None
+    _check_digest(text, src)
     lines = _cut_last_line(text, src).splitlines()
     header_kv: dict[str, str] = {}
     chan_meta: dict[str, tuple[str, str]] = {}
@@ -76,6 +92,8 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
                     parts = [p.strip() for p in val.split(";")]
                     if len(parts) >= 3:
                         chan_meta[parts[0]] = (parts[1], parts[2])
+                elif key == "sha256":
+                    pass
                 else:
                     header_kv[key] = val
             continue
@@ -118,6 +136,11 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
         r = int(nan_rows[0]) + 1 + int(has_header)
         raise ParameterError(f"{src}: data row {r} has missing values"
                              f"{' (truncated file?)' if nan_rows[0] == values.shape[0] - 1 else ''}")
+    if "n_samples" in header_kv:
+        stated = parse_number(header_kv["n_samples"], source=src, key="header n_samples")
+        if stated != values.shape[0]:
+            raise ParameterError(f"{src}: the header states {stated:g} samples but the file holds {values.shape[0]} "
+                                 "rows (a cut or edited file)")
     names, units = [], []
     for lab in labels:
         nm, un = _split_name_unit(lab)
@@ -149,14 +172,35 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
     data_cols = [i for i in range(len(names)) if i != tcol]
     if not data_cols:
         raise ParameterError(f"{src} has a time column but no data column")
+    locations = {}
+    if "channels_json" in header_kv:  # exact names (any character) written by vibmeasure
+        import json
+        try:
+            described = json.loads(header_kv["channels_json"])
+            exact = [(str(c["name"]), str(c["quantity"]), str(c["unit"]), str(c.get("location", "")))
+                     for c in described]
+        except (ValueError, TypeError, KeyError) as exc:
+            raise ParameterError(f"{src}: header channels_json is damaged ({exc})") from None
+        if len(exact) != len(data_cols):
+            raise ParameterError(f"{src}: header describes {len(exact)} channels but the file has {len(data_cols)} "
+                                 "data columns")
+        for i, (nm, q, u, loc) in zip(data_cols, exact):
+            names[i] = nm
+            chan_meta[nm] = (q, u)
+            locations[nm] = loc
     avail = [names[i] for i in data_cols]
     pick = [data_cols[j] for j in select_names(avail, channels, source=src)]
     quantities = [chan_meta.get(names[i], ("unknown", ""))[0] for i in pick]
     file_units = [chan_meta.get(names[i], (None, units[i] or ""))[1] for i in pick]
-    meta = {k: v for k, v in header_kv.items() if k not in _FS_KEYS and k != "t0_s"}
+    meta = {k: v for k, v in header_kv.items() if k not in _FS_KEYS and k not in ("t0_s", "n_samples", "channels_json")}
     meta["source"] = str(path)
-    return make_record(values[:, pick].T, fs, [names[i] for i in pick], quantity=quantity, unit=unit,
-                       quantities=quantities, units=file_units, t0=t0, meta=meta, source=src)
+    rec = make_record(values[:, pick].T, fs, [names[i] for i in pick], quantity=quantity, unit=unit,
+                      quantities=quantities, units=file_units, t0=t0, meta=meta, source=src)
+    if any(locations.values()):
+        from ..core.record import Channel
+        rec = rec.replace(channels=tuple(Channel(c.name, c.quantity, c.unit, locations.get(c.name, ""))
+                                         for c in rec.channels))
+    return rec
 
 
 def _is_number(s: str, decimal: str) -> bool:
@@ -172,13 +216,23 @@ def _is_number(s: str, decimal: str) -> bool:
 
 def write_csv(path, rec: Record, *, time_column: bool = True) -> None:
     """Write a record as CSV: metadata in '#' header lines, a time column, full float precision."""
-    head = ["# vibmeasure record, schema 1", f"# fs_hz = {rec.fs!r}", f"# t0_s = {rec.t0!r}"]
-    for c in rec.channels:
-        head.append(f"# channel = {c.name}; {c.quantity}; {c.unit}; {c.location}")
-    cols = (["time [s]"] if time_column else []) + [f"{c.name} [{c.unit}]" if c.unit else c.name
-                                                      for c in rec.channels]
+    import json
+    head = ["# vibmeasure record, schema 2", f"# fs_hz = {rec.fs!r}", f"# t0_s = {rec.t0!r}",
+            f"# n_samples = {rec.n_samples}",
+            "# channels_json = " + json.dumps([{"name": c.name, "quantity": c.quantity, "unit": c.unit,
+                                                 "location": c.location} for c in rec.channels])]
+
+    def label(c):  # the column row is for people and other tools; exact names are in channels_json
+        name = re.sub(r'[,;"\t\r\n\[\]()#]', "_", c.name) or "_"
+        return f"{name} [{c.unit}]" if c.unit else name
+    cols = (["time [s]"] if time_column else []) + [label(c) for c in rec.channels]
     arr = np.vstack([rec.time, rec.data]).T if time_column else rec.data.T
+    buf = io.StringIO()
+    buf.write(",".join(cols) + "\n")
+    np.savetxt(buf, arr, delimiter=",", fmt="%.17g")
+    body = buf.getvalue()
+    import hashlib
+    head.append(f"# sha256 = {hashlib.sha256(body.encode('utf-8')).hexdigest()}")  # of everything below
     with atomic_path(path) as tmp:
         with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write("\n".join(head) + "\n" + ",".join(cols) + "\n")
-            np.savetxt(fh, arr, delimiter=",", fmt="%.17g")
+            fh.write("\n".join(head) + "\n" + body)

@@ -25,6 +25,7 @@ def read_wav(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
     except (ValueError, EOFError, OSError, struct.error, wavfile.WavFileWarning) as exc:
         raise ParameterError(f"{src} is unreadable (truncated or not WAV): {exc}") from None
     check_size(data.size, source=src, max_samples=max_samples)
+    _check_digest(path, src)
     if data.dtype.kind not in "iuf":
         raise ParameterError(f"{src}: sample type {data.dtype} is not PCM integer or float")
     if fs is not None and float(fs) != float(rate):
@@ -51,3 +52,55 @@ def write_wav(path, rec: Record) -> None:
         raise ParameterError(f"WAV stores an integer sampling rate; fs={rec.fs} is not an integer: resample")
     with atomic_path(path) as tmp:
         wavfile.write(tmp, int(rec.fs), np.ascontiguousarray(rec.data.T))
+        _append_digest(tmp)
+
+
+_TAG = b"vibmeasure sha256="
+
+
+def _chunks(raw: bytes):
+    """(id, offset of the payload, size) of the chunks of a RIFF/WAVE file."""
+    pos = 12
+    while pos + 8 <= len(raw):
+        cid, size = raw[pos:pos + 4], struct.unpack("<I", raw[pos + 4:pos + 8])[0]
+        yield cid, pos + 8, size
+        pos += 8 + size + (size & 1)
+
+
+def _signed(raw: bytes) -> bytes | None:
+    """What the digest covers: the format chunk (how samples are decoded) and the data chunk."""
+    parts = {cid: raw[o:o + n] for cid, o, n in _chunks(raw) if cid in (b"fmt ", b"data")}
+    return parts[b"fmt "] + parts[b"data"] if len(parts) == 2 else None
+
+
+def _append_digest(path) -> None:
+    """A LIST/INFO chunk with the SHA-256 of the data chunk (players and scipy skip LIST chunks)."""
+    import hashlib
+    raw = open(path, "rb").read()
+    body = _signed(raw)
+    if body is None:
+        return
+    text = _TAG + hashlib.sha256(body).hexdigest().encode() + b"\0"
+    icmt = b"ICMT" + struct.pack("<I", len(text)) + text + (b"\0" if len(text) & 1 else b"")
+    chunk = b"LIST" + struct.pack("<I", 4 + len(icmt)) + b"INFO" + icmt
+    with open(path, "r+b") as fh:
+        fh.seek(0, 2)
+        fh.write(chunk)
+        size = fh.tell()
+        fh.seek(4)
+        fh.write(struct.pack("<I", size - 8))
+
+
+def _check_digest(path, src: str) -> None:
+    """A WAV vibmeasure wrote carries the SHA-256 of its samples: a changed sample is a named error."""
+    import hashlib
+    raw = open(path, "rb").read()
+    stated = None
+    for cid, o, n in _chunks(raw):
+        if cid == b"LIST" and raw[o:o + 4] == b"INFO":
+            i = raw.find(_TAG, o, o + n)
+            if i >= 0:
+                stated = raw[i + len(_TAG): i + len(_TAG) + 64]
+    body = _signed(raw)
+    if stated is not None and (body is None or hashlib.sha256(body).hexdigest().encode() != stated):
+        raise ParameterError(f"{src} is damaged: its samples do not match the SHA-256 vibmeasure wrote into it")

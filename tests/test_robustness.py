@@ -1,0 +1,338 @@
+"""Damaged, truncated and hostile files; writers killed mid-write; concurrent history updates.
+Each test is named after the rule it checks. benchmarks/fuzz.py runs the same classes at scale."""
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import h5py
+import numpy as np
+import pytest
+import scipy.io as sio
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import vibmeasure as vm
+
+
+@pytest.fixture
+def rec():
+    rng = np.random.default_rng(5)
+    return vm.Record(np.round(rng.normal(size=(2, 300)), 6), 1000.0,
+                     [vm.Channel("a", "acceleration", "g"), vm.Channel("b", "velocity", "m/s")])
+
+
+def _outcome(path, original, **kw):
+    """"named" (ParameterError), "exact" (the original data) or the defect it is."""
+    import warnings
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            r = vm.read(path, **kw)
+        except vm.ParameterError:
+            return "named"
+    if r.data.shape == original.shape and np.array_equal(r.data, original):
+        return "exact"
+    return "flagged" if any(issubclass(w.category, vm.QualityWarning) for w in caught) else "silent"
+
+
+# --- truncation -------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("ext", [".csv", ".h5", ".wav"])
+def test_a_file_vibmeasure_wrote_never_reads_wrong_when_cut(tmp_path, rec, ext):
+    p = vm.write(tmp_path / f"r{ext}", rec)
+    raw = p.read_bytes()
+    cuts = sorted({i + 1 for i, b in enumerate(raw) if b == 0x0A} | set(range(1, len(raw), max(1, len(raw) // 150))))
+    for k in cuts[:-1] if raw.endswith(b"\n") else cuts:
+        q = tmp_path / f"cut{ext}"
+        q.write_bytes(raw[:k])
+        assert _outcome(q, rec.data) in ("named", "exact"), (ext, k)   # exact: a cut inside a trailer
+
+
+def test_lvm_cut_at_any_line_end_or_inside_a_number_is_refused(tmp_path):
+    rows = [f"{i / 100:.2f}\t{np.sin(i):.6f}" for i in range(40)]
+    text = ("LabVIEW Measurement\t\nSeparator\tTab\n***End_of_Header***\t\n\nChannels\t1\t\nSamples\t40\t\n"
+            "Delta_X\t0.01\t\nX0\t0\t\n***End_of_Header***\t\nX_Value\ty\tComment\n" + "\n".join(rows) + "\n")
+    p = tmp_path / "r.lvm"
+    p.write_text(text)
+    original = vm.read(p).data
+    raw = text.encode()
+    for k in range(raw.index(b"X_Value"), len(raw) - 1):
+        p.write_bytes(raw[:k])
+        assert _outcome(p, original) == "named", k
+
+
+def test_csv_cut_inside_the_last_number_is_dropped_with_a_warning(tmp_path):
+    p = tmp_path / "third_party.csv"    # no vibmeasure header: nothing states the length
+    p.write_text("time,a\n0,1.5\n0.001,2.5\n0.002,3.25")
+    with pytest.warns(vm.QualityWarning, match="'0.002,3.25' has no end of line"):
+        r = vm.read(p)
+    assert r.n_samples == 2 and r.data[0, -1] == 2.5
+
+
+# --- flipped bytes ------------------------------------------------------------------------------------
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(ext=st.sampled_from([".csv", ".h5", ".wav"]), frac=st.floats(0, 1, exclude_max=True), bit=st.integers(0, 7))
+def test_a_flipped_byte_in_a_file_vibmeasure_wrote_is_named_or_harmless(tmp_path, rec, ext, frac, bit):
+    # the files carry a SHA-256 (HDF5 user block, CSV header, WAV LIST chunk): checked before parsing
+    p = vm.write(tmp_path / f"r{ext}", rec)
+    raw = bytearray(p.read_bytes())
+    raw[int(frac * len(raw))] ^= 1 << bit
+    q = tmp_path / f"f{ext}"
+    q.write_bytes(bytes(raw))
+    assert _outcome(q, rec.data) in ("named", "exact")
+
+
+# --- sizes: refused before anything is allocated ---------------------------------------------------------
+
+def test_hdf5_declaring_1e12_samples_is_refused_by_max_samples(tmp_path):
+    p = tmp_path / "huge.h5"
+    with h5py.File(p, "w") as f:
+        d = f.create_dataset("x", shape=(10 ** 12,), dtype="f8", chunks=(1024,))   # nothing written
+        d.attrs["fs"] = 1000.0
+    assert p.stat().st_size < 100_000
+    with pytest.raises(vm.ParameterError, match="declares 1,000,000,000,000 samples.*max_samples=250,000,000"):
+        vm.read(p, dataset="x")
+
+
+def test_wav_declaring_4_gib_is_refused(tmp_path, rec):
+    import struct
+    p = vm.write(tmp_path / "r.wav", rec)
+    raw = bytearray(p.read_bytes())
+    i = raw.find(b"data")
+    raw[i + 4: i + 8] = struct.pack("<I", 0xFFFFFFF0)
+    p.write_bytes(bytes(raw))
+    with pytest.raises(vm.ParameterError, match="WAV"):
+        vm.read(p)
+
+
+def test_mat_variable_above_max_samples_is_refused_before_decompression(tmp_path):
+    p = tmp_path / "bomb.mat"
+    sio.savemat(p, {"x": np.zeros(1_000_000, dtype=np.uint8), "fs": 1000.0}, do_compression=True)
+    assert p.stat().st_size < 20_000      # a small file that unpacks to a million samples
+    with pytest.raises(vm.ParameterError, match="variable 'x' declares 1,000,000 samples"):
+        vm.read(p, max_samples=100_000)
+    assert vm.read(p).n_samples == 1_000_000
+
+
+def test_csv_with_a_million_columns_is_refused(tmp_path):
+    p = tmp_path / "wide.csv"
+    p.write_text(",".join(["1"] * 1_000_000) + "\n")
+    with pytest.raises(vm.ParameterError, match="1,000,000 fields, above the limit"):
+        vm.read(p, fs=1.0)
+    with pytest.raises(vm.ParameterError, match="max_samples="):
+        vm.read(p, fs=1.0, max_samples=0)
+
+
+# --- contradictions and values ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("header,match", [("# fs_hz = 1,000", "ambiguous"), ("# fs = 1000\n# sampling_rate = 2000", "two"),
+                                          ("# fs = true", "not a number"), ("# fs = fast", "not a number")])
+def test_csv_header_numbers_are_strict(tmp_path, header, match):
+    p = tmp_path / "h.csv"
+    p.write_text(header + "\na,b\n1,2\n3,4\n")
+    with pytest.raises(vm.ParameterError, match=match):
+        vm.read(p)
+
+
+def test_inf_and_overflowing_numbers_are_refused_like_nan(tmp_path):
+    for bad in ("inf", "1e999", "-inf", "nan"):
+        p = tmp_path / "v.csv"
+        p.write_text(f"a\n1\n{bad}\n2\n")
+        with pytest.raises(vm.ParameterError, match="NaN/inf|missing"):
+            vm.read(p, fs=10.0)
+
+
+def test_a_quoted_numeric_first_row_is_data_not_a_header(tmp_path):
+    p = tmp_path / "q.csv"
+    p.write_text('"1.5","2.5"\n3,4\n5,6\n')
+    r = vm.read(p, fs=10.0)
+    assert r.n_samples == 3 and r.data[0, 0] == 1.5
+
+
+def test_complex_samples_are_refused_not_cut_to_their_real_part(tmp_path):
+    p = tmp_path / "c.h5"
+    with h5py.File(p, "w") as f:
+        f["x"] = np.exp(1j * np.arange(100.0))
+        f["x"].attrs["fs"] = 100.0
+    with pytest.raises(vm.ParameterError, match="imaginary"):
+        vm.read(p, dataset="x")
+
+
+def test_hdf5_boolean_or_text_fs_is_refused(tmp_path):
+    for val in (True, "fast"):
+        p = tmp_path / "b.h5"
+        with h5py.File(p, "w") as f:
+            f["x"] = np.arange(100.0)
+            f["x"].attrs["fs"] = val
+        with pytest.raises(vm.ParameterError, match="boolean|not a number"):
+            vm.read(p, dataset="x")
+
+
+def test_mat73_char_sparse_and_empty_variables_are_no_signals(tmp_path):
+    p = tmp_path / "v73.mat"
+    with h5py.File(p, "w", userblock_size=512) as f:
+        f["sig"] = np.arange(50.0)[:, None]
+        c = f.create_dataset("name", data=np.frombuffer("accelerometer".encode("utf-16-le"), "<u2")[:, None])
+        c.attrs["MATLAB_class"] = np.bytes_("char")
+        e = f.create_dataset("empty", data=np.array([0, 0], "u8"))
+        e.attrs["MATLAB_class"] = np.bytes_("double")
+        e.attrs["MATLAB_empty"] = np.uint8(1)
+        g = f.create_group("sp")
+        g.attrs["MATLAB_sparse"] = np.uint64(50)
+        g["data"] = np.ones(50)
+        g["ir"] = np.arange(50, dtype="u8")
+        g["jc"] = np.array([0, 50], "u8")
+    with open(p, "r+b") as fh:
+        fh.write(b"MATLAB 7.3 MAT-file".ljust(116) + b"\0" * 8 + b"\x00\x02IM")
+    r = vm.read(p, fs=10.0)
+    assert r.names == ["sig"]
+
+
+# --- security -------------------------------------------------------------------------------------------
+
+def test_hdf5_external_storage_cannot_read_other_files(tmp_path):
+    secret = tmp_path / "secret.bin"
+    secret.write_bytes(np.arange(64.0).tobytes())
+    p = tmp_path / "ext.h5"
+    with h5py.File(p, "w") as f:
+        d = f.create_dataset("x", shape=(64,), dtype="<f8", external=[(str(secret), 0, 512)])
+        d.attrs["fs"] = 10.0
+    with pytest.raises(vm.ParameterError, match="external raw files"):
+        vm.read(p, dataset="x")
+    assert vm.read(p, dataset="x", allow_external=True).data[0, 5] == 5.0   # when the user opts in
+
+
+def test_hdf5_external_links_are_refused(tmp_path, rec):
+    other = vm.write(tmp_path / "other.h5", rec)
+    p = tmp_path / "link.h5"
+    with h5py.File(p, "w") as f:
+        f["x"] = h5py.ExternalLink(str(other), "/data")
+    with pytest.raises(vm.ParameterError, match="external link"):
+        vm.read(p, dataset="x", fs=1000.0)
+
+
+# --- writers --------------------------------------------------------------------------------------------
+
+def test_writers_refuse_a_fifo_or_folder_at_the_output_path(tmp_path, rec):
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    with pytest.raises(vm.ParameterError, match="is a FIFO"):
+        vm.write(fifo, rec)
+    (tmp_path / "dir.h5").mkdir()
+    with pytest.raises(vm.ParameterError, match="is a folder"):
+        vm.write(tmp_path / "dir.h5", rec)
+    assert fifo.exists() and (tmp_path / "dir.h5").is_dir()
+
+
+def test_writers_keep_the_mode_of_a_replaced_file_and_leave_umask_alone(tmp_path, rec):
+    p = vm.write(tmp_path / "r.h5", rec)
+    os.chmod(p, 0o640)
+    before = os.umask(0o022)
+    os.umask(before)
+    vm.write(p, rec)
+    assert (p.stat().st_mode & 0o777) == 0o640
+    after = os.umask(before)
+    os.umask(after)
+    assert after == before
+    fresh = vm.write(tmp_path / "new.csv", rec)
+    assert (fresh.stat().st_mode & 0o777) == 0o666 & ~before
+
+
+def test_temporary_files_of_a_killed_writer_are_cleaned_on_the_next_write(tmp_path, rec):
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    stale = tmp_path / f".r.h5.{dead.pid}.deadbeef.part"
+    stale.write_bytes(b"half")
+    vm.write(tmp_path / "r.h5", rec)
+    assert not stale.exists()
+
+
+WRITER = textwrap.dedent("""
+    import sys, numpy as np, vibmeasure as vm
+    path, kind = sys.argv[1], sys.argv[2]
+    rec = vm.Record(np.random.default_rng(0).normal(size=(4, 200000)), 1000.0)
+    i = 0
+    while True:
+        i += 1
+        if kind == "history":
+            h = vm.History("p")
+            for k in range(1, 30):
+                h.add(vm.ModalEstimate(fn=[10.0 + k], zeta=[0.01]), time=float(k))
+            h.save(path)
+        else:
+            vm.write(path, rec.replace(data=rec.data + i))
+""")
+
+
+@pytest.mark.parametrize("name", ["r.h5", "r.csv", "r.wav", "history.h5"])
+def test_kill_9_at_any_moment_leaves_the_previous_file_or_the_new_one(tmp_path, name):
+    script = tmp_path / "writer.py"
+    script.write_text(WRITER)
+    path = tmp_path / name
+    kind = "history" if name.startswith("history") else "record"
+    rng = np.random.default_rng(1)
+    for trial in range(6):
+        proc = subprocess.Popen([sys.executable, str(script), str(path), kind])
+        time.sleep(0.8 + rng.uniform(0, 1.2))
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+        if path.exists():
+            if kind == "history":
+                assert len(vm.History.load(path).entries) == 29
+            else:
+                r = vm.read(path)
+                assert r.data.shape == (4, 200000)
+    leftovers = list(tmp_path.glob(f".{name}.*.part"))
+    if path.exists() and kind == "record":
+        vm.write(path, vm.read(path))    # the next write removes what the killed writers left
+        assert not list(tmp_path.glob(f".{name}.*.part"))
+    assert all(p.name.endswith(".part") for p in leftovers)
+
+
+HISTORY_WORKER = textwrap.dedent("""
+    import sys, time, vibmeasure as vm
+    path, who = sys.argv[1], float(sys.argv[2])
+    for k in range(20):
+        h = vm.History.load(path)   # load-add-save, as a user script does it
+        h.add(vm.ModalEstimate(fn=[10.0 + who], zeta=[0.01]), time=time.time())
+        h.save(path)
+""")
+
+
+def test_concurrent_history_updates_lose_nothing(tmp_path):
+    path = tmp_path / "h.h5"
+    vm.History("pump").add(vm.ModalEstimate(fn=[10.0], zeta=[0.01]), time=0.0).save(path)
+    script = tmp_path / "w.py"
+    script.write_text(HISTORY_WORKER)
+    procs = [subprocess.Popen([sys.executable, str(script), str(path), str(i)]) for i in range(2)]
+    assert all(p.wait(timeout=120) == 0 for p in procs)
+    assert len(vm.History.load(path).entries) == 1 + 40
+
+
+def test_a_damaged_history_file_is_a_named_error(tmp_path):
+    path = tmp_path / "h.h5"
+    with h5py.File(path, "w") as f:
+        f.attrs["vibmeasure_schema"] = "vibmeasure.history"
+        f.create_group("entry00000")
+    with pytest.raises(vm.ParameterError, match="damaged"):
+        vm.History.load(path)
+    from tests.test_cli import run
+    rec_path = tmp_path / "r.csv"
+    vm.write(rec_path, vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=4.0, seed=1))
+    code, _, err = run(["compare", str(rec_path), "--baseline", str(path)])
+    assert code == 2 and "damaged" in err and "Traceback" not in err
+
+
+def test_history_accepts_datetimes():
+    import datetime
+    import pandas as pd
+    h = vm.History("p")
+    h.add(vm.ModalEstimate(fn=[10.0], zeta=[0.01]), time=datetime.datetime(2026, 1, 1))
+    h.add(vm.ModalEstimate(fn=[10.0], zeta=[0.01]), time=pd.Timestamp("2026-01-02", tz="UTC"))
+    assert h.entries[1][0] - h.entries[0][0] == 86400.0
+    with pytest.raises(vm.ParameterError, match="finite"):
+        h.add(vm.ModalEstimate(fn=[10.0], zeta=[0.01]), time=float("nan"))
