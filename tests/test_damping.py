@@ -97,3 +97,16 @@ def test_classic_methods_bad_input():
         vm.half_power("file.csv")
     with pytest.raises(vm.FitError, match="cycle"):
         vm.log_decrement(vm.synth.free_decay(fn=10.0, zeta=0.01, fs=1000.0, duration=0.15, snr_db=40, seed=1))
+
+
+def test_half_power_searches_the_given_band_only():
+    # two modes: the band picks the weaker one (exact Lorentzian oracle: zeta within 3 %)
+    rec = vm.synth.free_decay(fn=[7.85, 50.4], zeta=[0.01, 0.005], amplitude=[0.3, 1.0], fs=2048.0,
+                              duration=20.0, seed=3, snr_db=60)
+    est = vm.half_power(rec, band=(5, 20))
+    assert est.fn[0] == pytest.approx(7.85, rel=2e-3) and est.zeta[0] == pytest.approx(0.01, rel=0.03)
+    assert vm.half_power(rec).fn[0] == pytest.approx(50.4, rel=2e-3)   # without a band: the strongest
+    with pytest.raises(vm.ParameterError, match="band="):
+        vm.half_power(rec, band=(float("nan"), -3))
+    with pytest.raises(vm.FitError, match="edge|outside band"):  # no peak inside (20, 40) Hz
+        vm.half_power(rec, band=(20, 40))

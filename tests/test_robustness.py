@@ -336,3 +336,19 @@ def test_history_accepts_datetimes():
     assert h.entries[1][0] - h.entries[0][0] == 86400.0
     with pytest.raises(vm.ParameterError, match="finite"):
         h.add(vm.ModalEstimate(fn=[10.0], zeta=[0.01]), time=float("nan"))
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(ext=st.sampled_from([".csv", ".h5", ".wav"]), frac=st.floats(0, 1, exclude_max=True),
+       command=st.sampled_from(["ringdown", "spectrum", "diagnose"]))
+def test_the_cli_never_prints_a_traceback_on_a_damaged_file(tmp_path, ext, frac, command):
+    from tests.test_cli import run
+    rec = vm.synth.free_decay(fn=12.0, zeta=0.02, fs=1000.0, duration=3.0, seed=2)
+    raw = bytearray(vm.write(tmp_path / f"r{ext}", rec).read_bytes())
+    raw[int(frac * len(raw))] ^= 0x40
+    q = tmp_path / f"d{ext}"
+    q.write_bytes(bytes(raw))
+    argv = [command, str(q)] + (["--rpm", "600"] if command == "diagnose" else [])
+    code, out, err = run(argv)
+    assert code in (0, 2), err
+    assert "Traceback" not in err and "Traceback" not in out

@@ -505,10 +505,28 @@ def _report_text(args, rec, est, caught, out):
 
 
 def main(argv=None, *, out=None, err=None) -> int:
-    """Run the command line; returns the exit code (0 ok, 2 error)."""
+    """Run the command line; returns the exit code (0 ok, 2 error in the input, 3 a defect of
+    vibmeasure). A user never sees a Python traceback (VIBMEASURE_DEBUG=1 shows it for a report)."""
+    import os
     out = out or sys.stdout
     err = err or sys.stderr
     args = _parser().parse_args(argv)
+    try:
+        return _dispatch(args, out, err)
+    except BrokenPipeError:  # the reader of our output went away (| head)
+        return 0
+    except (VibMeasureError, OSError) as exc:
+        print(f"vibmeasure: error: {exc}", file=err)
+        return 2
+    except Exception as exc:  # noqa: BLE001 - the last net: a defect, said as one
+        if os.environ.get("VIBMEASURE_DEBUG"):
+            raise
+        print(f"vibmeasure: error: unexpected {type(exc).__name__}: {exc}. This is a defect of vibmeasure; "
+              "please report it with the command (VIBMEASURE_DEBUG=1 shows the traceback)", file=err)
+        return 3
+
+
+def _dispatch(args, out, err) -> int:
     if args.command == "spectrum":
         return _main_spectrum(args, out, err)
     if args.command in ("frf", "modes"):

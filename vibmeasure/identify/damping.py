@@ -76,7 +76,11 @@ def _halfpower_points(x, fs, band):
     f = np.fft.rfftfreq(nfft, 1 / fs)
     sel = np.ones_like(f, bool) if band is None else (f >= band[0]) & (f <= band[1])
     sel[0] = False
-    k = np.flatnonzero(sel)[int(np.argmax(P[sel]))]
+    idx = np.flatnonzero(sel)
+    k = idx[int(np.argmax(P[sel]))]
+    if band is not None and k in (idx[0], idx[-1]):
+        raise FitError(f"half_power: the strongest line in band={band} sits on its edge ({f[k]:.4g} Hz): no peak "
+                       "inside the band")
     f1, f2, _, _ = half_power_crossings(f, P, k, lower_msg="a half-power point lies outside the spectrum "
                                         "(damping too high or the peak at the band edge)")
     return f1, f2
@@ -268,8 +272,8 @@ def half_power(obj, *, band=None, channel=None, start: float | None = None, fs: 
         return half_power_frf(obj, band=band, output=0 if channel is None else channel)
     if not isinstance(obj, (Record, np.ndarray, list, tuple)):
         raise ParameterError(f"obj must be a ring-down Record (or array with fs), got {type(obj).__name__}")
-    rec, idx, x, band, flags, i0, _ = _prepare(obj, channel, None, start, fs)
-    band = check_band(band, rec.fs)
+    rec, idx, x, _, flags, i0, _ = _prepare(obj, channel, None, start, fs)
+    band = check_band(band, rec.fs)   # the peak is searched in the user's band (no band-pass: it would widen it)
     fsr = rec.fs
     n = x.size
     f1, f2 = _halfpower_points(x, fsr, band)
@@ -279,6 +283,8 @@ def half_power(obj, *, band=None, channel=None, start: float | None = None, fs: 
         raise FitError(f"half_power: the record does not capture the decay (sigma*T = {sigma * T:.2f} < "
                        f"{MIN_SIGMA_T:g}): truncation widens the peak; use vm.ringdown or a longer record")
     fd = 0.5 * (f1 + f2)
+    if band is not None and not band[0] <= fd <= band[1]:
+        raise FitError(f"half_power: the peak found ({fd:.4g} Hz) lies outside band={band}; no mode in that band")
     wd = 2 * np.pi * fd
     wn = np.hypot(wd, sigma)
     zeta = sigma / wn
