@@ -352,3 +352,73 @@ def test_the_cli_never_prints_a_traceback_on_a_damaged_file(tmp_path, ext, frac,
     code, out, err = run(argv)
     assert code in (0, 2), err
     assert "Traceback" not in err and "Traceback" not in out
+
+
+# --- numbers at the edges ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("call,match", [
+    (lambda: vm.amplitude_spectrum(vm.Record.from_array(1e300 * np.sin(np.arange(4096.0)), fs=100.0)), "1e\\+300"),
+    (lambda: vm.psd(vm.Record.from_array(1e-300 * np.sin(np.arange(4096.0)), fs=100.0)), "underflow"),
+    (lambda: vm.integrate(vm.Record.from_array(1e200 * np.sin(np.arange(4096.0)), fs=100.0, quantity="acceleration",
+                                               unit="m/s^2")), "overflow"),
+    (lambda: vm.diagnose(vm.Record.from_array(1e-300 * np.sin(np.arange(40960.0)), fs=1000.0, quantity="acceleration",
+                                              unit="g"), rpm=600), "underflow"),
+], ids=["amplitude-1e300", "psd-1e-300", "integrate-1e200", "diagnose-1e-300"])
+def test_amplitudes_whose_powers_leave_double_precision_are_refused(call, match):
+    # before: inf spectra, 0 PSDs and "none, confidence 1.00"
+    with pytest.raises(vm.ParameterError, match=match):
+        call()
+
+
+def test_negative_damping_is_refused_in_every_model():
+    M, K = np.eye(2), np.array([[2.0, -1], [-1, 2]]) * 1e4
+    with pytest.raises(vm.ParameterError, match="rayleigh"):
+        vm.models.MDOF(M, K, rayleigh=(-0.5, 0.0))
+    with pytest.raises(vm.ParameterError, match="negative eigenvalue"):
+        vm.models.MDOF(M, K, -np.eye(2))
+    with pytest.raises(vm.ParameterError, match="zeta"):
+        vm.models.Beam(E=210e9, I=1e-8, rho=7850, A=1e-4, L=1.0, bc="cantilever", zeta=-0.01).modes(2)
+    with pytest.raises(vm.ParameterError, match="at most 200"):
+        vm.models.Beam(E=210e9, I=1e-8, rho=7850, A=1e-4, L=1.0, bc="cantilever").modes(10 ** 6)
+
+
+def test_frf_inputs_that_cannot_excite_are_refused(rng):
+    x = rng.normal(size=8192)
+    live = vm.Record(np.vstack([x, np.convolve(x, [1, 0.5], "same")]), 1024.0,
+                     [vm.Channel("force", "force", "N"), vm.Channel("acc", "acceleration", "m/s^2")])
+    with pytest.raises(vm.ParameterError, match="all zeros"):
+        vm.estimate_frf(live.replace(data=np.vstack([np.zeros(8192), live.data[1]])), input="force")
+    with pytest.raises(vm.ParameterError, match="constant"):
+        vm.estimate_frf(live.replace(data=np.vstack([np.full(8192, 3.0), live.data[1]])), input="force")
+    two = vm.Record(np.vstack([x, x, live.data[1]]), 1024.0, [vm.Channel("f1", "force", "N"),
+                    vm.Channel("f2", "force", "N"), vm.Channel("acc", "acceleration", "m/s^2")])
+    with pytest.raises(vm.ParameterError, match="identical"):
+        vm.estimate_frf(two, input=["f1", "f2"])
+    with pytest.raises(vm.ParameterError, match="H1"):
+        vm.estimate_frf(live, input="force", estimator="H3")
+    for bad in (-1, 1e9, float("nan")):
+        with pytest.raises(vm.ParameterError, match="pretrigger"):
+            vm.impact_frf(live, input="force", pretrigger=bad)
+
+
+def test_no_frequency_at_or_above_nyquist_and_no_nan_options():
+    fs = 1000.0
+    n = np.arange(4000)
+    nyq = vm.Record.from_array(np.cos(np.pi * n) * np.exp(-n / 2000.0), fs=fs)   # a 500 Hz decay at fs 1 kHz
+    import warnings
+    for method in (vm.hilbert_decay, vm.log_decrement, vm.ringdown):
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", vm.QualityWarning)
+                est = method(nyq)
+        except (vm.FitError, vm.ParameterError):
+            continue   # refused: fine
+        # an answer must lie strictly below Nyquist and above the resolution of the 4 s record
+        assert np.all(est.fn < 0.499 * fs) and np.all(est.fn * nyq.duration >= 1), (method.__name__, est)
+    dec = vm.synth.free_decay(fn=12.0, zeta=0.02, fs=fs, duration=5.0, seed=1)
+    with pytest.raises(vm.ParameterError, match="start="):
+        vm.ringdown(dec, start=float("nan"))
+    with pytest.raises(vm.ParameterError, match="prominence="):
+        vm.pick_peaks(vm.amplitude_spectrum(dec), prominence=float("nan"))
+    with pytest.raises(vm.ParameterError, match="empty"):
+        vm.Record.from_array([], fs=fs)

@@ -8,7 +8,22 @@ from .errors import ParameterError
 from .record import Record
 
 __all__ = ["as_record", "response_channel", "clean_signal", "check_band", "positive", "name_index",
-           "select_names"]
+           "select_names", "check_range"]
+
+# amplitudes whose squares (powers, spectra, likelihoods) stay inside double precision
+RANGE = (1e-150, 1e150)
+
+
+def check_range(data, *, what: str = "rec") -> None:
+    """Refuse amplitudes whose powers overflow or underflow double precision (|x| above 1e150 or, when
+    not all zero, below 1e-150): a spectrum of inf or 0 would be a silent wrong answer."""
+    a = np.asarray(data)
+    if a.size == 0 or a.dtype.kind not in "fc":
+        return
+    m = float(np.max(np.abs(a)))
+    if m > RANGE[1] or 0 < m < RANGE[0]:
+        raise ParameterError(f"{what} peaks at {m:.3g}: outside {RANGE[0]:g}..{RANGE[1]:g}, where its power would "
+                             "overflow or underflow double precision; rescale it (choose another unit)")
 
 
 def as_record(obj, *, fs: float | None = None, name: str = "rec") -> Record:

@@ -93,6 +93,8 @@ class Record:
         ``names`` several.
         """
         a = np.asarray(x)
+        if a.size == 0:
+            raise ParameterError(f"x is empty (shape {a.shape}): a record needs samples")
         n_ch = 1 if a.ndim == 1 else (a.shape[0] if a.ndim == 2 else -1)
         if n_ch < 0:
             raise ParameterError(f"x must be 1-D or (n_channels, n_samples), got shape {a.shape}")

@@ -36,7 +36,8 @@ def _prepare(rec, channel, band, start, fs):
     if start is None:
         i0, _ = decay_start(rec, idx, x)
     else:
-        i0 = int(round(float(start) * rec.fs))
+        from ..core._validate import positive
+        i0 = int(round(positive(start, "start", allow_zero=True) * rec.fs))
         if not 0 <= i0 < x.size - 16:
             raise ParameterError(f"start={start} s is outside the record (0..{rec.duration:g} s)")
     x = x[i0:]
@@ -54,6 +55,12 @@ def _prepare(rec, channel, band, start, fs):
 
 
 def _finish(rec, idx, method, fn, zeta, fn_std, zeta_std, flags, extras):
+    if fn and fn >= 0.499 * rec.fs:
+        raise FitError(f"{method}: the decay's frequency {fn:.4g} Hz is at the Nyquist limit (fs/2 = {rec.fs / 2:g} Hz): "
+                       "aliased or unresolved; sample faster (at least 10 x the frequency)")
+    if fn and fn * rec.duration < 1:
+        raise FitError(f"{method}: {fn:.4g} Hz completes less than one cycle in the {rec.duration:g} s record: below "
+                       "the frequency resolution")
     if not np.isfinite(zeta) or zeta <= 0:
         raise FitError(f"{method}: the amplitude does not decay (zeta = {zeta:.3g}); not a free decay")
     if fn and rec.fs / fn < 10:

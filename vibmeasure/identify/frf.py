@@ -52,7 +52,28 @@ def _io(rec: Record, input, outputs):
         raise ParameterError("no output channel: the record holds only the input(s)")
     if set(oo) & set(ii):
         raise ParameterError("a channel cannot be both input and output")
+    _check_inputs(rec, ii)
     return ii, oo
+
+
+def _check_inputs(rec: Record, ii):
+    """A force channel must excite: not dead (zero or constant), not NaN/inf; several inputs must not
+    be copies of each other (the input matrix would be singular). Clipping is flagged by impact_frf."""
+    from ..core._validate import clean_signal
+    xs = []
+    for i in ii:
+        name = rec.channels[i].name
+        if not np.any(rec.data[i]):
+            raise ParameterError(f"input channel {name!r} is all zeros: a dead force channel (check the hammer or "
+                                 "shaker cable); no FRF can be formed")
+        x = clean_signal(rec, i, min_samples=16, what="input")   # NaN/inf and constant are refused here
+        xs.append(x - x.mean())
+    if len(xs) > 1:
+        c = np.corrcoef(np.vstack(xs))
+        off = np.abs(c[~np.eye(len(xs), dtype=bool)])
+        if off.max() > 0.9999:
+            raise ParameterError("two input channels are identical (correlation > 0.9999): the input cross-spectral "
+                                 "matrix is singular; a MIMO FRF needs independent excitations")
 
 
 def _h_from_sums(Gxx, Gyx, Gyy, estimator, n_in):
@@ -199,6 +220,13 @@ def impact_frf(rec, *, input="force", outputs=None, record_length: float | None 
     fsr = rec.fs
     force = rec.data[ii[0]]
     hits = find_hits(force, fsr, threshold=threshold)
+    try:
+        pretrigger = float(pretrigger)
+    except (TypeError, ValueError):
+        raise ParameterError(f"pretrigger={pretrigger!r} must be a number of seconds") from None
+    if not (np.isfinite(pretrigger) and 0 <= pretrigger < rec.duration / 2):
+        raise ParameterError(f"pretrigger={pretrigger!r} s must be >= 0 and shorter than half the record "
+                             f"({rec.duration / 2:g} s)")
     pre = int(round(pretrigger * fsr))
     pre = min(pre, int(hits[0]))  # a hit at the very start leaves less pre-trigger
     spacing = np.diff(hits)

@@ -281,7 +281,8 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     notes: list[str] = []
 
     if start is not None:
-        i0 = int(round(float(start) * fsr))
+        from ..core._validate import positive
+        i0 = int(round(positive(start, "start", allow_zero=True) * fsr))
         if not 0 <= i0 < x_all.size - 16:
             raise ParameterError(f"start={start} s is outside the record (0..{rec.duration:g} s)")
         how = "given"
@@ -522,6 +523,10 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         mode_flags[pos].append("amplitude_dependent")
     if "zeta_vs_amplitude" in nl:
         extras["zeta_vs_amplitude"] = nl["zeta_vs_amplitude"]
+    if np.any(fn_r >= 0.499 * fsr):
+        raise FitError(f"ringdown: a mode at {float(np.max(fn_r)):.4g} Hz is at the Nyquist limit (fs/2 = {fsr / 2:g} Hz): "
+                       "aliased or unresolved; sample faster (at least 10 x the frequency)")
+    extras.setdefault("channel", rec.channels[idx].name)
     est = ModalEstimate(fn=fn_r, zeta=zeta_r, fn_std=fn_std_r, zeta_std=zeta_std_r, method="ml",
                         flags=tuple(flags), mode_flags=tuple(tuple(m) for m in mode_flags), amplitude=amp[ik],
                         phase=phase[ik], unit=rec.channels[idx].unit, extras=extras)

@@ -16,8 +16,13 @@ __all__ = ["Rod", "Shaft", "String", "Beam", "beta_l", "stiffness", "pendulum_pe
 _G0 = 9.80665
 
 
+MAX_MODES = 200   # beyond this cosh(beta L) overflows double precision in the beam equations
+
+
 def _est(fn, zeta, name, shapes=None):
     fn = np.asarray(fn, float)
+    if not (np.isfinite(zeta) and 0 <= zeta < 1):
+        raise ParameterError(f"zeta={zeta!r} must be in [0, 1): negative damping makes an unstable model")
     return ModalEstimate(fn=fn, zeta=np.full(fn.size, zeta), fn_std=np.zeros(fn.size), zeta_std=np.zeros(fn.size),
                          method=f"model:{name}", shapes=shapes)
 
@@ -25,6 +30,9 @@ def _est(fn, zeta, name, shapes=None):
 def _n(n):
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise ParameterError(f"n={n!r} must be an integer >= 1 (number of modes)")
+    if n > MAX_MODES:
+        raise ParameterError(f"n={n!r} modes: at most {MAX_MODES} (higher modes of a continuum model are beyond "
+                             "double precision and beyond the slender-beam assumptions)")
     return int(n)
 
 

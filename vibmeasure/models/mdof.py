@@ -53,15 +53,27 @@ class MDOF:
             self.C = Mphi @ np.diag(2 * z * self._w) @ Mphi.T
             self.kind = "modal"
         elif rayleigh is not None:
-            a, b = rayleigh
+            try:
+                a, b = (float(v) for v in rayleigh)
+            except (TypeError, ValueError):
+                raise ParameterError(f"rayleigh={rayleigh!r} must be a pair (alpha, beta)") from None
+            if not (np.isfinite(a) and np.isfinite(b)) or a < 0 or b < 0:
+                raise ParameterError(f"rayleigh={rayleigh!r}: alpha and beta must be finite and >= 0 (negative "
+                                     "damping makes an unstable model)")
             self.C = a * self.M + b * self.K
             self.kind = "rayleigh"
         elif C is not None:
             C = np.asarray(C, float)
             if C.shape != self.M.shape:
                 raise ParameterError(f"C has shape {C.shape}; M is {self.M.shape}")
+            if not np.all(np.isfinite(C)):
+                raise ParameterError("C must hold finite values")
             if not np.allclose(C, C.T, atol=1e-12 * max(np.abs(C).max(), 1e-300)):
                 raise ParameterError("C must be symmetric")
+            lo = float(np.min(linalg.eigvalsh(C))) if C.any() else 0.0
+            if lo < -1e-12 * max(np.abs(C).max(), 1e-300):
+                raise ParameterError(f"C has a negative eigenvalue ({lo:.3g}): negative damping makes an unstable "
+                                     "model; C must be positive semi-definite")
             self.C = C
             self.kind = "general"
         else:

@@ -114,10 +114,8 @@ def _accel(rec, i, flags):
         x = _units.convert(x, ch.unit, "m/s^2")
     elif "unit_unknown" not in flags:
         flags.append("unit_unknown")
-    peak = float(np.max(np.abs(x)))
-    if not 1e-200 < peak < 1e200:
-        raise ParameterError(f"channel {ch.name!r} peaks at {peak:g}: outside the range 1e-200..1e200 that the "
-                             "spectra can represent; rescale the record (check its unit)")
+    from ..core._validate import check_range
+    check_range(x, what=f"channel {ch.name!r}")
     return x
 
 

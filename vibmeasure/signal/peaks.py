@@ -95,9 +95,12 @@ def pick_peaks(spec: Spectrum, *, n: int | None = None, prominence: float | None
         if not np.isfinite(min_distance_hz) or min_distance_hz <= 0:
             raise ParameterError(f"min_distance_hz={min_distance_hz!r} must be > 0")
         dist = max(1, int(round(min_distance_hz / df)))
-    prom = float(10 * np.median(vals[1:])) if prominence is None else float(prominence)
-    if prom < 0:
-        raise ParameterError(f"prominence={prominence!r} must be >= 0")
+    try:
+        prom = float(10 * np.median(vals[1:])) if prominence is None else float(prominence)
+    except (TypeError, ValueError):
+        raise ParameterError(f"prominence={prominence!r} must be a number") from None
+    if not np.isfinite(prom) or prom < 0:
+        raise ParameterError(f"prominence={prominence!r} must be a finite number >= 0")
     idx, props = find_peaks(vals, prominence=prom, distance=dist)
     keep = sel[idx]
     idx, proms = idx[keep], props["prominences"][keep]

@@ -120,6 +120,8 @@ def differentiate(rec, *, method: str = "frequency", channels=None, fs: float | 
 
 def _calculus(rec, direction, method, highpass, channels, fs):
     rec = as_record(rec, fs=fs)
+    from ..core._validate import check_range
+    check_range(rec.data)
     if method not in ("frequency", "time"):
         raise ParameterError(f"method={method!r} must be 'frequency' or 'time'")
     hp = positive(highpass, "highpass", allow_zero=True)

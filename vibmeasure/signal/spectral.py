@@ -44,9 +44,12 @@ class _ArraySource:
 def _source(rec, fs=None):
     from ..core._validate import as_record
     from ..io.lazy import LazyRecord
+    from ..core._validate import check_range
     if isinstance(rec, LazyRecord):
         return rec
-    return _ArraySource(as_record(rec, fs=fs))
+    rec = as_record(rec, fs=fs)
+    check_range(rec.data)
+    return _ArraySource(rec)
 
 
 def _channel_indices(src, channels) -> list[int]:
