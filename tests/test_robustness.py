@@ -422,3 +422,37 @@ def test_no_frequency_at_or_above_nyquist_and_no_nan_options():
         vm.pick_peaks(vm.amplitude_spectrum(dec), prominence=float("nan"))
     with pytest.raises(vm.ParameterError, match="empty"):
         vm.Record.from_array([], fs=fs)
+
+
+@pytest.mark.parametrize("body,match", [
+    ('type = "sdof"\n[parameters]\nm = ' + "[" * 3000 + "1" + "]" * 3000 + '\nk = "1 N/m"\n', "not valid TOML|nested"),
+    ('type = "sdof"\n[parameters]\nm = [[[[[[[[1]]]]]]]]\nk = "1 N/m"\n', "nested"),
+    ('type = "sdof"\n[parameters]\nm = "1.2.3 kg"\nk = "1000 N/m"\nzeta = 0.01\n', "'1.2.3' is not a number"),
+    ('type = "sdof"\n[parameters]\nm = 1979-05-27\nk = "1000 N/m"\nzeta = 0.01\n', "has no unit"),
+    ('type = "mdof"\n[parameters]\nM = { value = "x", unit = "kg" }\nK = { value = 1, unit = "N/m" }\n', "number"),
+], ids=["deep-nesting", "nested-matrix", "1.2.3-kg", "date-value", "text-matrix"])
+def test_malformed_model_files_are_named_errors_within_a_second(tmp_path, body, match):
+    p = tmp_path / "m.toml"
+    p.write_text(body)
+    t0 = time.perf_counter()
+    with pytest.raises(vm.ParameterError, match=match):
+        vm.models.load(p)
+    assert time.perf_counter() - t0 < 1.0
+
+
+def test_a_huge_model_file_is_refused_before_parsing(tmp_path):
+    p = tmp_path / "big.toml"
+    n = 2000
+    row = "[" + ",".join(["0.0"] * n) + "]"
+    p.write_text('type = "mdof"\n[parameters]\nM = { value = [' + ",".join([row] * n) + '], unit = "kg" }\n')
+    t0 = time.perf_counter()
+    with pytest.raises(vm.ParameterError, match="larger than any model"):
+        vm.models.load(p)
+    assert time.perf_counter() - t0 < 1.0
+
+
+def test_a_model_without_damping_says_so(tmp_path):
+    p = tmp_path / "m.toml"
+    p.write_text('type = "sdof"\n[parameters]\nm = "1 kg"\nk = "1000 N/m"\n')
+    with pytest.warns(vm.QualityWarning, match="no damping"):
+        assert vm.models.load(p).zeta == 0.0

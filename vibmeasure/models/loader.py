@@ -59,7 +59,10 @@ def _quantity(name, v, src):
         m = re.match(r"^\s*([-+0-9.eE]+)\s*(.+?)\s*$", v)
         if not m:
             raise ParameterError(f"{src}: parameter {name} = {v!r} must be 'number unit', e.g. '40 N/mm'")
-        value, unit = float(m.group(1)), m.group(2)
+        try:
+            value, unit = float(m.group(1)), m.group(2)
+        except ValueError:
+            raise ParameterError(f"{src}: parameter {name} = {v!r}: {m.group(1)!r} is not a number") from None
     else:
         raise ParameterError(f"{src}: parameter {name} = {v!r} has no unit; write e.g. {name} = \"{v} "
                              f"{ {'mass': 'kg', 'stiffness': 'N/m'}.get(_NEEDS[name][0], 'SI-unit') }\"")
@@ -68,7 +71,35 @@ def _quantity(name, v, src):
     dim, f = _U[unit]
     if dim not in _NEEDS[name]:
         raise ParameterError(f"{src}: {name!r} must be a {' or '.join(_NEEDS[name])}, not {dim} ({unit!r})")
-    return np.asarray(value, float) * f
+    try:
+        arr = np.asarray(value, float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{src}: parameter {name!r}: its value must be a number or a matrix of numbers") from None
+    if arr.size > MAX_MATRIX or arr.ndim > 2 or not np.all(np.isfinite(arr)):
+        raise ParameterError(f"{src}: parameter {name!r} has shape {arr.shape}: at most a {MAX_DOF} x {MAX_DOF} "
+                             "matrix of finite numbers")
+    return arr * f
+
+
+MAX_DOF = 500                 # an MDOF model beyond this is an FE model: use a dedicated FE tool
+MAX_MATRIX = MAX_DOF * MAX_DOF
+MAX_BYTES = 4_000_000            # three 500 x 500 matrices of ~8-digit numbers fit; tomllib parses 4 MB in < 1 s
+
+
+def _depth(v, limit: int, level: int = 0) -> int:
+    """Nesting depth of lists and tables, stopping past the limit (no recursion blow-up)."""
+    stack = [(v, level)]
+    deepest = 0
+    while stack:
+        x, d = stack.pop()
+        deepest = max(deepest, d)
+        if deepest > limit:
+            return deepest
+        if isinstance(x, dict):
+            stack.extend((y, d + 1) for y in x.values())
+        elif isinstance(x, list):
+            stack.extend((y, d + 1) for y in x)
+    return deepest
 
 
 def load(path) -> object:
@@ -81,10 +112,15 @@ def load(path) -> object:
     src = f"model file {str(path)!r}"
     if not p.exists():
         raise ParameterError(f"path={str(path)!r} does not exist")
+    if p.stat().st_size > MAX_BYTES:
+        raise ParameterError(f"{src} is {p.stat().st_size:,} bytes: larger than any model this loader takes "
+                             f"(at most {MAX_DOF} degrees of freedom)")
     try:
         doc = tomllib.loads(p.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise ParameterError(f"{src} is not valid TOML: {exc}") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError, RecursionError, ValueError) as exc:
+        raise ParameterError(f"{src} is not valid TOML: {str(exc)[:200] or type(exc).__name__}") from None
+    if _depth(doc, 6) > 6:
+        raise ParameterError(f"{src}: values are nested deeper than a model needs (tables and matrices, 6 levels)")
     kind = doc.get("type")
     if kind not in _TYPES:
         raise ParameterError(f"{src}: type={kind!r} must be one of {sorted(_TYPES)}")
@@ -92,6 +128,12 @@ def load(path) -> object:
     if not isinstance(raw, dict) or not raw:
         raise ParameterError(f"{src}: a [parameters] table is required")
     par = {k: _quantity(k, v, src) for k, v in raw.items()}
+    if kind in ("sdof", "beam", "rod", "shaft", "string") and not {"zeta", "c", "loss_factor"} & set(par) or \
+            kind == "mdof" and not {"C", "rayleigh", "modal_zeta"} & set(par):
+        import warnings
+        from ..core.errors import QualityWarning
+        warnings.warn(f"{src} gives no damping (zeta, c, loss_factor; or C, rayleigh, modal_zeta for mdof): the model "
+                      "is undamped (zeta = 0)", QualityWarning, stacklevel=2)
     try:
         if kind == "sdof":
             return SDOF(**{k: float(v) for k, v in par.items()})
@@ -104,5 +146,7 @@ def load(path) -> object:
         if kind == "shaft":
             return Shaft(**{k: (v if k == "bc" else float(v)) for k, v in par.items()})
         return String(**{k: float(v) for k, v in par.items()})
-    except TypeError as exc:
+    except (TypeError, ValueError) as exc:
+        if isinstance(exc, ParameterError):
+            raise
         raise ParameterError(f"{src}: parameters do not fit a {kind} model: {exc}") from None
