@@ -190,7 +190,8 @@ def main():
             defects += [(fmt, lab, o) for lab, o in zip(labels, outcomes) if o.split(":")[0] in
                         ("raw", "silent", "crash", "hang")]
         if defects:
-            print("\ndefects (format, mutation, outcome):")
+            print("\nnot named (format, mutation, outcome); a 'silent' flip in mat, mat73, lvm or uff changed a sample")
+            print("value in a format that carries no checksum: no reader can tell it from a real value")
             for d, n in Counter(defects).most_common(30):
                 print(f"  {n:4d} x {d}")
         else:
