@@ -376,8 +376,11 @@ def _fused(spectra: list) -> list:
         nv = min(s.n_valid for s in group)
         r = np.mean([s.r[:n] for s in group], axis=0)
         amp = np.sqrt(np.mean([s.amp[:n] ** 2 for s in group], axis=0))
-        out.append(_SES("+".join(s.channel for s in group), prep + " (channels fused)", group[0].band,
-                        group[0].freq[:n], amp, r, nv, shape=len(group)))
+        bands = {s.band for s in group}
+        band = group[0].band if len(bands) == 1 else (min(b[0] for b in bands), max(b[1] for b in bands))
+        label = prep + (" (channels fused)" if len(bands) == 1 else " (channels fused, each in its own band)")
+        out.append(_SES("+".join(s.channel for s in group), label, band, group[0].freq[:n], amp, r, nv,
+                        shape=len(group)))
     return out
 
 
