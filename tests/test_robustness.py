@@ -456,3 +456,22 @@ def test_a_model_without_damping_says_so(tmp_path):
     p.write_text('type = "sdof"\n[parameters]\nm = "1 kg"\nk = "1000 N/m"\n')
     with pytest.warns(vm.QualityWarning, match="no damping"):
         assert vm.models.load(p).zeta == 0.0
+
+
+def test_a_time_column_or_a_hammer_pulse_is_not_analysed_by_default(tmp_path):
+    import warnings
+    t = np.arange(5000) / 1000.0
+    x = np.exp(-0.02 * 2 * np.pi * 12 * t) * np.cos(2 * np.pi * 12 * t)
+    p = tmp_path / "headerless.csv"
+    np.savetxt(p, np.vstack([t, x]).T, delimiter=",")
+    with pytest.warns(vm.QualityWarning, match="'ch0' looks like a time column; analysing 'ch1'"):
+        est = vm.ringdown(vm.read(p, fs=1000.0))
+    assert est.extras["channel"] == "ch1" and est.fn[0] == pytest.approx(12.0024, rel=1e-4)  # the damped fd oracle
+    hammer = np.zeros(5000)
+    hammer[100:104] = [0.2, 1.0, 0.7, 0.1]
+    rec = vm.Record(np.vstack([hammer, np.r_[np.zeros(100), x[:4900]]]), 1000.0)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        est = vm.ringdown(rec)
+    assert est.extras["channel"] == "ch1"
+    assert any("looks like a force pulse" in str(w.message) for w in caught)

@@ -39,16 +39,45 @@ def as_record(obj, *, fs: float | None = None, name: str = "rec") -> Record:
     raise ParameterError(f"{name} must be a vm.Record or an array with fs, got {type(obj).__name__}")
 
 
+def _looks_like(x: np.ndarray) -> str | None:
+    """"time" for a uniform increasing ramp (a time column read as data), "impulse" for short one-sided
+    pulses (a hammer force: the samples above half the peak are few and all of one sign, where a
+    ring-down swings both ways), else None."""
+    x = np.asarray(x, float)
+    if x.size < 16 or not np.all(np.isfinite(x)):
+        return None
+    d = np.diff(x)
+    if np.all(d > 0) and np.ptp(d) <= 1e-6 * abs(float(np.mean(d))):
+        return "time"
+    y = x - np.median(x)
+    big = np.abs(y) > 0.5 * float(np.max(np.abs(y)))
+    if big.sum() <= max(4, x.size // 200) and (np.all(y[big] > 0) or np.all(y[big] < 0)):
+        return "impulse"
+    return None
+
+
 def response_channel(rec: Record, channel) -> int:
-    """The channel to analyse: the one named, the only one, or the first that is not a force."""
+    """The channel to analyse: the one named, the only one, or the first that is not a force. Channels
+    of unknown quantity that look like a time column or a hammer pulse are passed over when another is
+    left, with a QualityWarning naming both (name the channel to override)."""
     if channel is not None:
         return rec.index(channel)
     if rec.n_channels == 1:
         return 0
-    for i, c in enumerate(rec.channels):
-        if c.quantity != "force":
+    cands = [i for i, c in enumerate(rec.channels) if c.quantity != "force"]
+    if not cands:
+        raise ParameterError(f"channel=None but every channel of {rec.names} is a force; name the response channel")
+    skipped = []
+    for i in cands:
+        kind = _looks_like(rec.data[i]) if rec.channels[i].quantity in ("unknown", "") else None
+        if kind is None:
+            if skipped:
+                from .errors import warn_quality
+                warn_quality(f"channel=None: {', '.join(f'{n!r} looks like a {k}' for n, k in skipped)}; analysing "
+                             f"{rec.channels[i].name!r} (name the channel to choose another)", stacklevel=4)
             return i
-    raise ParameterError(f"channel=None but every channel of {rec.names} is a force; name the response channel")
+        skipped.append((rec.channels[i].name, "time column" if kind == "time" else "force pulse"))
+    return cands[0]
 
 
 def clean_signal(rec: Record, idx: int, *, min_samples: int = 16, what: str = "rec") -> np.ndarray:
