@@ -399,6 +399,8 @@ def test_frf_inputs_that_cannot_excite_are_refused(rng):
     for bad in (-1, 1e9, float("nan")):
         with pytest.raises(vm.ParameterError, match="pretrigger"):
             vm.impact_frf(live, input="force", pretrigger=bad)
+    with pytest.raises(vm.ParameterError, match="not an impact test"):
+        vm.impact_frf(live, input="force")   # random excitation: 70 % of samples above 10 % of the peak
 
 
 def test_no_frequency_at_or_above_nyquist_and_no_nan_options():

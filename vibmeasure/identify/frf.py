@@ -175,6 +175,9 @@ def estimate_frf(rec, *, input="force", outputs=None, estimator: str = "H1", npe
                 "detrend": detrend})
 
 
+MAX_BUSY = 0.05   # an impact record's force is near zero except in its pulses: above 5 % it is continuous
+
+
 def find_hits(force, fs: float, *, threshold: float = 0.1, min_gap_s: float | None = None) -> np.ndarray:
     """Sample indices where hammer hits start: rising crossings of threshold x the largest peak,
     at least ``min_gap_s`` apart (default 0.1 s)."""
@@ -227,6 +230,11 @@ def impact_frf(rec, *, input="force", outputs=None, record_length: float | None 
     if not (np.isfinite(pretrigger) and 0 <= pretrigger < rec.duration / 2):
         raise ParameterError(f"pretrigger={pretrigger!r} s must be >= 0 and shorter than half the record "
                              f"({rec.duration / 2:g} s)")
+    busy = float(np.mean(np.abs(force - np.median(force)) > threshold * np.max(np.abs(force - np.median(force)))))
+    if busy > MAX_BUSY:
+        raise ParameterError(f"not an impact test: the force exceeds {threshold:.0%} of its peak in {busy:.0%} of the "
+                             f"samples, where hammer pulses last a few ms per hit (at most {MAX_BUSY:.0%}); for "
+                             "continuous (shaker, random) excitation use vm.estimate_frf")
     pre = int(round(pretrigger * fsr))
     pre = min(pre, int(hits[0]))  # a hit at the very start leaves less pre-trigger
     spacing = np.diff(hits)
