@@ -110,3 +110,15 @@ def test_half_power_searches_the_given_band_only():
         vm.half_power(rec, band=(float("nan"), -3))
     with pytest.raises(vm.FitError, match="edge|outside band"):  # no peak inside (20, 40) Hz
         vm.half_power(rec, band=(20, 40))
+
+
+def test_log_decrement_with_a_band_stays_on_the_mode_despite_an_offset(shared_data):
+    # an offset made the band-pass ring at its 5 Hz edge, and the decrement reported that ringing
+    # (5.175 Hz) instead of the 7.85 Hz mode; now the trend is removed before filtering
+    rec = vm.synth.free_decay(fn=[7.85, 50.4], zeta=[0.01, 0.005], amplitude=[1.0, 1.0], fs=2048.0, duration=20.0,
+                              seed=4, snr_db=60, dc_offset=50.0)
+    est = vm.log_decrement(rec, band=(5, 20))
+    assert est.fn[0] == pytest.approx(7.85, rel=2e-3) and est.zeta[0] == pytest.approx(0.01, rel=0.05)
+    real = vm.read(shared_data("ringdown/dexpilab1_VDeXpiLab1_Exp.mat"), channels=["Fe.Out.Acc[0]"])
+    est = vm.log_decrement(real, band=(5, 20))
+    assert 7.8 < est.fn[0] < 8.0   # the steel beam's mode (7.85-7.93 Hz along its backbone)

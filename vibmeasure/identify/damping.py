@@ -47,7 +47,9 @@ def _prepare(rec, channel, band, start, fs):
     if band is not None:
         sos = _sig.butter(4, band if band[0] > 0 else band[1], btype="bandpass" if band[0] > 0 else "lowpass",
                           fs=rec.fs, output="sos")
-        x = _sig.sosfiltfilt(sos, x)
+        # an offset or drift would make the filter ring at the band edge at both ends: remove it first
+        tt = np.arange(x.size)
+        x = _sig.sosfiltfilt(sos, x - np.polyval(np.polyfit(tt, x, 1), tt))
         # the filter's ringing at both ends: wait until its slowest pole has decayed by e^-7
         r_min = float(np.min(-np.log(np.abs(_sig.sos2zpk(sos)[1])))) * rec.fs
         skip = int(min(x.size // 4, 7 * rec.fs / r_min))
@@ -127,7 +129,7 @@ def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: 
         raise ParameterError(f"n={n!r} must be None (regression) or an integer >= 1 (cycles apart)")
     rec, idx, x, band, flags, i0, skip = _prepare(rec, channel, band, start, fs)
     fsr = rec.fs
-    fd0 = spectral_peak(x, fsr, band)
+    fd0 = spectral_peak(x[skip: x.size - skip] if skip else x, fsr, band)  # without the filter's end effects
     x = x - baseline_line(x, fsr, fd0)  # offset and drift would shift the extremes in time
     noise = max(noise_std(x, fsr), 1e-9 * float(np.max(np.abs(x))))
     tp, ap = cycle_peaks(x, fsr, fd0)
@@ -174,6 +176,10 @@ def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: 
     dz = 4 * np.pi ** 2 / (4 * np.pi ** 2 + delta ** 2) ** 1.5
     zeta_std = float(dz * delta_std)
     fd = 1.0 / Td
+    if abs(fd - fd0) > 0.05 * fd0:
+        raise FitError(f"log_decrement: the extremes repeat at {fd:.4g} Hz but the spectrum peaks at {fd0:.4g} Hz"
+                       f"{f' in band={band}' if band is not None else ''}: they do not belong to one mode (close "
+                       "modes, a band edge or noise); narrow the band around the mode or use vm.ringdown")
     fn = fd / np.sqrt(1 - zeta ** 2)
     fn_std = float(fn * Td_std / Td)
     return _finish(rec, idx, "logdec", fn, zeta, fn_std, zeta_std, flags,
