@@ -3,31 +3,93 @@
 >>> import vibmeasure as vm
 >>> rec = vm.synth.free_decay(fn=10.37, zeta=0.02, fs=1000.0, duration=10.0, snr_db=40, seed=1)
 >>> est = vm.ringdown(rec)          # ModalEstimate: fn, zeta, fn_std, zeta_std, flags
+
+The data model and errors load with the package; every analysis module (and scipy behind it) loads
+on first use of its name, so ``import vibmeasure`` and ``vibmeasure --help`` start fast.
 """
 
-from . import models, synth
+from importlib import import_module as _import_module
+
 from .core import units
 from .core.errors import FitError, ParameterError, QualityWarning, UnitError, VibMeasureError
 from .core.record import Channel, Record
 from .core.results import FRF, Kurtogram, ModalEstimate, Peaks, Spectrogram, Spectrum
-from .identify.damping import half_power, hilbert_decay, log_decrement, zeta_from_delta
-from .identify.frf import estimate_frf, find_hits, impact_frf
-from .identify.modal import circle_fit, fit_modes, mac, modal_crb, synthesize_frf
-from .identify.ringdown import ringdown, ringdown_crb
-from .models.bearing import BEARINGS, Bearing, Gear
-from .monitor.compare import Comparison, History, compare
-from .monitor.machinery import Diagnosis, diagnose, severity_zone
-from .io import LazyRecord, read, read_frf, read_spectrum, write
-from .io import open_record as open  # noqa: A001  (vm.open: the documented name)
-from .signal.demod import envelope, envelope_spectrum, order_track, time_synchronous_average
-from .signal.kurtogram import band_ses, kurtogram
-from .signal.whiten import prewhiten, remove_synchronous
-from .signal.peaks import harmonic_family, pick_peaks, sideband_family
-from .signal.preprocess import decimate, detrend, differentiate, integrate, resample
-from .signal.preprocess import filter  # noqa: A004  (vm.filter: Butterworth, zero-phase)
-from .signal.spectral import amplitude_spectrum, band_rms, coherence, csd, octave_bands, psd, spectrogram
 
 __version__ = "0.1.0"
+
+# public name -> (module, attribute): imported when first used (PEP 562)
+_LAZY = {
+    "half_power": (".identify.damping", "half_power"),
+    "hilbert_decay": (".identify.damping", "hilbert_decay"),
+    "log_decrement": (".identify.damping", "log_decrement"),
+    "zeta_from_delta": (".identify.damping", "zeta_from_delta"),
+    "estimate_frf": (".identify.frf", "estimate_frf"),
+    "find_hits": (".identify.frf", "find_hits"),
+    "impact_frf": (".identify.frf", "impact_frf"),
+    "circle_fit": (".identify.modal", "circle_fit"),
+    "fit_modes": (".identify.modal", "fit_modes"),
+    "mac": (".identify.modal", "mac"),
+    "modal_crb": (".identify.modal", "modal_crb"),
+    "synthesize_frf": (".identify.modal", "synthesize_frf"),
+    "ringdown": (".identify.ringdown", "ringdown"),
+    "ringdown_crb": (".identify.ringdown", "ringdown_crb"),
+    "BEARINGS": (".models.bearing", "BEARINGS"),
+    "Bearing": (".models.bearing", "Bearing"),
+    "Gear": (".models.bearing", "Gear"),
+    "Comparison": (".monitor.compare", "Comparison"),
+    "History": (".monitor.compare", "History"),
+    "compare": (".monitor.compare", "compare"),
+    "Diagnosis": (".monitor.machinery", "Diagnosis"),
+    "diagnose": (".monitor.machinery", "diagnose"),
+    "severity_zone": (".monitor.machinery", "severity_zone"),
+    "LazyRecord": (".io", "LazyRecord"),
+    "read": (".io", "read"),
+    "read_frf": (".io", "read_frf"),
+    "read_spectrum": (".io", "read_spectrum"),
+    "write": (".io", "write"),
+    "open": (".io", "open_record"),
+    "envelope": (".signal.demod", "envelope"),
+    "envelope_spectrum": (".signal.demod", "envelope_spectrum"),
+    "order_track": (".signal.demod", "order_track"),
+    "time_synchronous_average": (".signal.demod", "time_synchronous_average"),
+    "band_ses": (".signal.kurtogram", "band_ses"),
+    "kurtogram": (".signal.kurtogram", "kurtogram"),
+    "prewhiten": (".signal.whiten", "prewhiten"),
+    "remove_synchronous": (".signal.whiten", "remove_synchronous"),
+    "harmonic_family": (".signal.peaks", "harmonic_family"),
+    "pick_peaks": (".signal.peaks", "pick_peaks"),
+    "sideband_family": (".signal.peaks", "sideband_family"),
+    "decimate": (".signal.preprocess", "decimate"),
+    "detrend": (".signal.preprocess", "detrend"),
+    "differentiate": (".signal.preprocess", "differentiate"),
+    "integrate": (".signal.preprocess", "integrate"),
+    "resample": (".signal.preprocess", "resample"),
+    "filter": (".signal.preprocess", "filter"),
+    "amplitude_spectrum": (".signal.spectral", "amplitude_spectrum"),
+    "band_rms": (".signal.spectral", "band_rms"),
+    "coherence": (".signal.spectral", "coherence"),
+    "csd": (".signal.spectral", "csd"),
+    "octave_bands": (".signal.spectral", "octave_bands"),
+    "psd": (".signal.spectral", "psd"),
+    "spectrogram": (".signal.spectral", "spectrogram"),
+    "models": (".", "models"),
+    "synth": (".", "synth"),
+}
+
+
+def __getattr__(name: str):
+    try:
+        mod, attr = _LAZY[name]
+    except KeyError:
+        raise AttributeError(f"module 'vibmeasure' has no attribute {name!r}") from None
+    value = _import_module("." + attr, __name__) if mod == "." else getattr(_import_module(mod, __name__), attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __all__ = [
     "Channel", "Record", "LazyRecord", "ModalEstimate", "FRF", "Spectrum", "Spectrogram", "Peaks", "Kurtogram",

@@ -27,13 +27,16 @@ _MAGIC = b"VIBMEASURE-SEAL-SHA256 "
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
-def _digest(path, start: int = USERBLOCK) -> str:
+def _digest(path, start: int = USERBLOCK, fh=None) -> str:
+    """SHA-256 of the bytes from ``start`` on, of the file at path or of an open file."""
     import hashlib
+    if fh is None:
+        with open(path, "rb") as own:
+            return _digest(path, start, own)
     h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        fh.seek(start)
-        for block in iter(lambda: fh.read(1 << 22), b""):
-            h.update(block)
+    fh.seek(start)
+    for block in iter(lambda: fh.read(1 << 22), b""):
+        h.update(block)
     return h.hexdigest()
 
 
@@ -50,8 +53,12 @@ def check_seal(path, src: str) -> bool:
     """Before HDF5 parses a file: a file vibmeasure sealed must match its checksum, so a damaged
     byte anywhere is a named error here instead of a crash, a hang or a silently changed number
     inside the HDF5 library. Returns True for a verified file, False for an unsealed one."""
-    with open(path, "rb") as fh:
+    with open(path, "rb") as fh:  # one open file: a writer's rename meanwhile cannot mix two versions
         head = fh.read(USERBLOCK + len(_HDF5_SIGNATURE))
+        return _check_head(path, fh, head, src)
+
+
+def _check_head(path, fh, head: bytes, src: str) -> bool:
     copies = [head[:USERBLOCK // 2], head[USERBLOCK // 2: USERBLOCK]]
     ours = [c for c in copies if c.startswith(_MAGIC)]
     looks_ours = ours or any(b"VIBMEASURE" in c or b"SEAL-SHA256" in c for c in copies)
@@ -61,7 +68,7 @@ def check_seal(path, src: str) -> bool:
         raise ParameterError(f"{src} is damaged: its HDF5 signature after the seal is missing (truncated or "
                              "overwritten)")
     stated = {c[len(_MAGIC): len(_MAGIC) + 64] for c in ours}
-    actual = _digest(path).encode()
+    actual = _digest(path, fh=fh).encode()
     if actual not in stated:
         raise ParameterError(f"{src} is damaged: its content does not match the SHA-256 vibmeasure wrote into it "
                              "(a changed or cut byte; or the file was edited after writing)")
