@@ -477,3 +477,13 @@ def test_a_time_column_or_a_hammer_pulse_is_not_analysed_by_default(tmp_path):
         est = vm.ringdown(rec)
     assert est.extras["channel"] == "ch1"
     assert any("looks like a force pulse" in str(w.message) for w in caught)
+
+
+def test_vm_open_refuses_a_dataset_that_stores_nothing_of_what_it_declares(tmp_path):
+    # before: vm.psd over 10^12 unwritten samples sat at 0 % for ever
+    p = tmp_path / "huge.h5"
+    with h5py.File(p, "w") as f:
+        d = f.create_dataset("x", shape=(10 ** 12,), dtype="f8", chunks=(1024,))
+        d.attrs["fs"] = 1000.0
+    with pytest.raises(vm.ParameterError, match="declares 8,000,000,000,000 bytes but stores 0"):
+        vm.open(p, dataset="x")

@@ -96,6 +96,19 @@ class LazyRecord:
                 f"{self.dtype}, {str(self.path)!r}:{self.dataset})")
 
 
+MAX_RATIO = 1000   # declared bytes over stored bytes: vibration data never compresses this far
+
+
+def _check_stored(d, path):
+    """A dataset must store what it declares: unwritten chunks read as zeros, forever, and a
+    compression ratio beyond MAX_RATIO is a bomb, not a measurement."""
+    declared = int(np.prod(d.shape, dtype=np.float64)) * d.dtype.itemsize
+    stored = d.id.get_storage_size()
+    if declared > (1 << 20) and stored * MAX_RATIO < declared:
+        raise ParameterError(f"HDF5 file {str(path)!r}: dataset {d.name!r} declares {declared:,} bytes but stores "
+                             f"{stored:,} (unwritten, or compressed more than {MAX_RATIO}x): refused")
+
+
 def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: float | None = None,
                 quantity: str | None = None, unit: str | None = None) -> LazyRecord:
     """Open an HDF5 record lazily (out-of-core).
@@ -122,6 +135,7 @@ def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: floa
         schema = schema.decode() if isinstance(schema, bytes) else schema
         if dataset is None and schema == SCHEMA:
             d = f["data"]
+            _check_stored(d, p)
             a = d.attrs
             chans = tuple(Channel(n, q, u, loc) for n, q, u, loc in zip(
                 _str_list(a["channel_names"]), _str_list(a["channel_quantities"]),
@@ -135,7 +149,9 @@ def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: floa
             raise ParameterError(f"{str(path)!r} is not a vibmeasure record file: name the dataset (dataset=...)")
         if dataset not in f:
             raise ParameterError(f"dataset={dataset!r} is not in {str(path)!r}")
-        d = f[dataset]
+        from .hdf5 import _dataset
+        d = _dataset(f, dataset, f"HDF5 file {str(path)!r}", allow_external=False, max_samples=2 ** 62)
+        _check_stored(d, p)
         if d.ndim not in (1, 2) or d.dtype.kind not in "fiu":
             raise ParameterError(f"dataset={dataset!r} must be 1-D or (n_channels, n_samples) numbers, "
                                  f"got shape {d.shape} dtype {d.dtype}")
