@@ -45,3 +45,19 @@ def test_open_errors(tmp_path):
     bad.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 50)
     with pytest.raises(vm.ParameterError, match="unreadable"):
         vm.open(bad)
+
+
+def test_envelope_spectrum_of_a_lazy_record_is_streamed_and_exact(tmp_path):
+    # x = A (1 + m cos 2 pi fm t) cos 2 pi fc t: the SES line at fm is 2 m A^2 (segments of 20000 put fm on a bin);
+    # the record is never loaded whole (segments of nperseg samples, half overlap)
+    import vibmeasure as vm
+    fs, n, A, m = 10000.0, 400_000, 1.5, 0.4
+    t = np.arange(n) / fs
+    x = A * (1 + m * np.cos(2 * np.pi * 50 * t)) * np.cos(2 * np.pi * 2500 * t)
+    p = vm.write(tmp_path / "am.h5", vm.Record.from_array(x, fs=fs))
+    seen = []
+    s = vm.envelope_spectrum(vm.open(p), band=(2000, 3000), nperseg=20000, progress=seen.append)
+    assert s.values[0][np.argmin(np.abs(s.freq - 50))] == pytest.approx(2 * m * A ** 2, rel=1e-6)
+    assert s.params["streamed"] and s.params["averages"] == 39 and seen[-1] == 1.0
+    mem = vm.envelope_spectrum(vm.read(p), band=(2000, 3000), nperseg=20000)   # the in-memory path agrees on the line
+    assert mem.values[0][np.argmin(np.abs(mem.freq - 50))] == pytest.approx(2 * m * A ** 2, rel=1e-3)

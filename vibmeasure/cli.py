@@ -394,11 +394,10 @@ def _spectrum(args, out, err):
         elif args.kind == "amplitude":
             spec = spectral.amplitude_spectrum(rec, nperseg=args.nperseg, window=args.window, scaling=args.scaling,
                                                channels=chans, progress=bar)
-        else:
-            if not hasattr(rec, "data"):
-                rec = rec.load()
+        else:   # a lazy record is streamed in segments (bounded memory, with progress)
             spec = demod.envelope_spectrum(rec, band=args.band, channel=chans[0] if chans else None,
-                                           window=args.window, nperseg=args.nperseg)
+                                           window=args.window, nperseg=args.nperseg,
+                                           progress=bar if not hasattr(rec, "data") else None)
     finally:
         bar.close()
     band = tuple(args.band) if args.band and args.kind != "envelope" else None
