@@ -91,7 +91,8 @@ def _envelope_spectrum_streamed(rec, *, band, channel, nperseg, progress):
         if progress is not None:
             progress((j + 1) / len(starts))
     c = rec.channels[i]
-    return Spectrum(k, acc[None] / len(starts), "envelope", power_unit(c.unit, density=False), (c.name,), c.quantity,
+    return Spectrum(k, acc[None] / len(starts), "envelope", power_unit(c.unit, density=False), (f"{c.name}.env",),
+                    c.quantity,
                     {"window": "hann", "nperseg": seg, "noverlap": seg - step, "averages": len(starts),
                      "band_hz": (lo, hi), "squared": True, "streamed": True})
 
