@@ -67,6 +67,7 @@ def envelope_spectrum(rec, *, band, channel=None, window="hann", nperseg: int | 
 
 def _envelope_spectrum_streamed(rec, *, band, channel, nperseg, progress):
     """Averaged squared-envelope spectrum of one channel of a lazy record, segment by segment."""
+    from scipy import fft as sfft
     from .spectral import power_unit
     lo, hi = _band(rec, band)
     i = response_channel(rec, channel) if hasattr(rec, "data") else (rec.index(channel) if channel is not None else 0)
@@ -84,10 +85,11 @@ def _envelope_spectrum_streamed(rec, *, band, channel, nperseg, progress):
         x = np.asarray(rec.read(s0, s0 + seg)[i], float)
         if not np.isfinite(x).all():
             raise ParameterError(f"channel {rec.names[i]!r} has NaN/inf samples near sample {s0}")
-        X = np.fft.rfft(x - x.mean())
-        X[~keep] = 0.0
-        e = np.abs(np.fft.ifft(np.r_[2 * X, np.zeros(seg - X.size)])) ** 2   # |analytic signal|^2
-        acc += np.abs(np.fft.rfft((e - e.mean()) * w)) * (2.0 / w.sum())
+        X = sfft.rfft(x - x.mean(), workers=-1)
+        Xb = np.zeros(seg, complex)
+        Xb[np.flatnonzero(keep)] = 2 * X[keep]
+        e = np.abs(sfft.ifft(Xb, workers=-1)) ** 2   # |analytic signal of the band|^2
+        acc += np.abs(sfft.rfft((e - e.mean()) * w, workers=-1)) * (2.0 / w.sum())
         if progress is not None:
             progress((j + 1) / len(starts))
     c = rec.channels[i]
