@@ -279,7 +279,7 @@ def _bearing_rows(job: _Job, f1: float, speed: dict):
 
 # --- decision ---------------------------------------------------------------------------------------
 
-def _decide(table, job: _Job, ev):
+def _decide(table, job: _Job):
     """The top fault: the most confident shaft-order or bearing fault at TOP_CONFIDENCE or more and not
     tied with another of its own kind; else "none" with the reason and the strongest candidate."""
     ranked = table.assign(_bearing=table.fault.isin(list(FAMILIES)))
@@ -362,7 +362,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         rows.append(sf.gear_row(f, A, f1, job.gear, _line, _row, LINE_DB))
     import pandas as pd
     table = pd.DataFrame(rows).sort_values("confidence", ascending=False, ignore_index=True)
-    top, conf, reason, also, where = _decide(table, job, ev)
+    top, conf, reason, also, where = _decide(table, job)
     if "speed_inconsistent" in job.flags:
         reason += "; " + speed["note"]
     if job.bearing is None:
