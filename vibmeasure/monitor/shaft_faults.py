@@ -67,9 +67,9 @@ def resonance_row(f, V, f1, order, level, rows, row, line_db):
         if db > res_db:
             res_db, res_f = db, float(fk)
     # a healthy machine's acceleration floor is flat to about 1 dB around the orders: a hump from 5 dB
-    # on is a mode (full weight at 10 dB); from 3 dB on it already casts doubt on the order's own fault
+    # on is a mode (full weight at 10 dB); from 2 dB on it already casts doubt on the order's own fault
     res_conf = level * float(np.clip((res_db - 5) / 5, 0, 1)) if res_f is not None else 0.0
-    doubt = level * float(np.clip((res_db - 3) / 4, 0, 1)) if res_f is not None else 0.0
+    doubt = level * float(np.clip((res_db - 2) / 4, 0, 1)) if res_f is not None else 0.0
     for r in rows:
         if res_f is not None and ((r["fault"] == "unbalance" and abs(res_f - f1) < 0.5 * f1) or
                                   (r["fault"] == "misalignment" and abs(res_f - 2 * f1) < 0.5 * f1)):
