@@ -544,11 +544,35 @@ def half_power_frf(obj, *, band=None, output=0, input=0) -> ModalEstimate:
     return est
 
 
+def _circle_angles_fit(w, ang, wn0, zeta0, a0):
+    """Least squares of the angles around the circle's centre on the exact viscous-mobility law
+    ang = a0 + s 2 atan((w^2 - wn^2) / (2 zeta wn w)): fn, zeta and their covariance (residual scale)."""
+    from scipy.optimize import least_squares
+    sgn = 1.0 if ang[-1] > ang[0] else -1.0
+
+    def res(p):
+        wn, z, a = p
+        return ang - (a + sgn * 2 * np.arctan((w ** 2 - wn ** 2) / (2 * z * wn * w)))
+    sol = least_squares(res, [wn0, max(zeta0, 1e-6), a0], x_scale=[wn0, max(zeta0, 1e-6), 1.0],
+                        bounds=([w[0], 1e-9, -np.inf], [w[-1], 1.0, np.inf]), xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    J = sol.jac
+    dof = max(ang.size - 3, 1)
+    s2 = float(sol.fun @ sol.fun) / dof
+    try:
+        cov = np.linalg.inv(J.T @ J) * s2
+    except np.linalg.LinAlgError:
+        cov = np.full((3, 3), np.nan)
+    return float(sol.x[0]), float(sol.x[1]), float(sol.x[2]), cov
+
+
 def circle_fit(frf: FRF, *, band, output=0, input=0) -> ModalEstimate:
     """SDOF circle fit (Kennedy-Pancu) on the mobility around one peak in ``band``.
 
-    The mobility of a mode traces a circle; fn is where the angle sweeps fastest and
-    zeta = (wb^2 - wa^2) / (2 wn^2 (tan(theta_a/2) + tan(theta_b/2))) averaged over point pairs.
+    The mobility of a viscously damped mode traces a circle on which the angle from the resonance
+    point obeys tan(theta / 2) = (w^2 - wn^2) / (2 zeta wn w) exactly. Start values: fn where the
+    angle sweeps fastest and the median zeta of point pairs; then fn, zeta and the resonance angle
+    by least squares on all points, with standard deviations from the residual scale (exact on exact
+    data; zero std there).
     """
     if not isinstance(frf, FRF):
         raise ParameterError(f"frf must be a vm.FRF, got {type(frf).__name__}")
@@ -578,10 +602,13 @@ def circle_fit(frf: FRF, *, band, output=0, input=0) -> ModalEstimate:
         for b_idx in range(j + 1, f.size):
             ta, tb = abs(ang[a_idx] - a_n), abs(ang[b_idx] - a_n)
             if 0.2 < ta < 2.5 and 0.2 < tb < 2.5:
-                zs.append((w[b_idx] ** 2 - w[a_idx] ** 2) / (2 * wn ** 2 * (np.tan(ta / 2) + np.tan(tb / 2))))
+                # mobility, viscous damping: tan(theta / 2) = (w^2 - wn^2) / (2 zeta wn w), exactly
+                num = (w[b_idx] ** 2 - wn ** 2) / w[b_idx] + (wn ** 2 - w[a_idx] ** 2) / w[a_idx]
+                zs.append(num / (2 * wn * (np.tan(ta / 2) + np.tan(tb / 2))))
     if not zs:
         raise FitError("circle_fit: too few points on either side of the resonance in band")
-    zeta = float(np.median(zs))
-    return ModalEstimate(fn=[wn / (2 * np.pi)], zeta=[zeta], fn_std=[np.nan],
-                         zeta_std=[float(np.std(zs) / np.sqrt(len(zs)))], method="circle",
+    wn, zeta, a_n, cov = _circle_angles_fit(w, ang, wn, float(np.median(zs)), a_n)
+    fn_std = float(np.sqrt(cov[0, 0])) / (2 * np.pi)
+    return ModalEstimate(fn=[wn / (2 * np.pi)], zeta=[zeta], fn_std=[fn_std],
+                         zeta_std=[float(np.sqrt(cov[1, 1]))], method="circle",
                          extras={"center": [float(xc), float(yc)], "radius": float(rad)})
