@@ -487,3 +487,16 @@ def test_vm_open_refuses_a_dataset_that_stores_nothing_of_what_it_declares(tmp_p
         d.attrs["fs"] = 1000.0
     with pytest.raises(vm.ParameterError, match="declares 8,000,000,000,000 bytes but stores 0"):
         vm.open(p, dataset="x")
+
+
+def test_running_out_of_memory_is_a_named_error(monkeypatch):
+    # 1e8 samples made amplitude_spectrum, ringdown, integrate ... raise a raw MemoryError; the public
+    # functions now say what ran out and what to do (here the allocation failure is simulated)
+    import vibmeasure.signal.spectral as spectral
+
+    def no_memory(*args, **kwargs):
+        raise MemoryError
+    monkeypatch.setattr(spectral, "_averaged_power", no_memory)
+    rec = vm.Record.from_array(np.sin(np.arange(8192.0)), fs=100.0)
+    with pytest.raises(vm.ParameterError, match="psd: not enough memory for 8,192 samples x 1 channel"):
+        vm.psd(rec)

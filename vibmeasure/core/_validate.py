@@ -8,7 +8,25 @@ from .errors import ParameterError
 from .record import Record
 
 __all__ = ["as_record", "response_channel", "clean_signal", "check_band", "positive", "name_index",
-           "select_names", "check_range"]
+           "select_names", "check_range", "memory_guard"]
+
+
+def memory_guard(func):
+    """A public function that runs out of memory says so, with the record's size, instead of a raw
+    MemoryError from deep inside numpy."""
+    import functools
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        try:
+            return func(*args, **kwargs)
+        except MemoryError:
+            rec = args[0] if args else None
+            n = getattr(rec, "n_samples", None)
+            size = f" for {n:,} samples x {getattr(rec, 'n_channels', 1)} channel(s)" if n else ""
+            raise ParameterError(f"{func.__name__}: not enough memory{size}; cut the record (slice_time, "
+                                 "channels=...), decimate it, or stream it with vm.open and nperseg") from None
+    return wrapper
 
 # amplitudes whose squares (powers, spectra, likelihoods) stay inside double precision
 RANGE = (1e-150, 1e150)

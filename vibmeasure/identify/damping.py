@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _sig
 
-from ..core._validate import as_record, check_band, clean_signal, response_channel
+from ..core._validate import as_record, check_band, clean_signal, memory_guard, response_channel
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import ModalEstimate
 from ._decay import baseline_line, clipped_mask, cycle_peaks, decay_start, noise_std, spectral_peak
@@ -114,6 +114,7 @@ def half_power_crossings(freq, P, k, *, lower_msg: str):
     return float(f1), float(f2), lo, hi
 
 
+@memory_guard
 def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: float | None = None,
                   fs: float | None = None) -> ModalEstimate:
     """Damping from the logarithmic decrement of successive cycle amplitudes.
@@ -187,6 +188,7 @@ def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: 
                     "noise_std": noise, "start_s": i0 / fsr + rec.t0})
 
 
+@memory_guard
 def hilbert_decay(rec, *, channel=None, band=None, start: float | None = None,
                   fs: float | None = None) -> ModalEstimate:
     """Damping from the Hilbert envelope of the band-passed decay.
@@ -268,6 +270,7 @@ def hilbert_decay(rec, *, channel=None, band=None, start: float | None = None,
                     "start_s": i0 / fsr + rec.t0})
 
 
+@memory_guard
 def half_power(obj, *, band=None, channel=None, start: float | None = None, fs: float | None = None) -> ModalEstimate:
     """Half-power bandwidth: of an FRF or spectrum peak (exact relations per form, see
     :func:`vibmeasure.identify.modal.half_power_frf`), or of the ring-down spectrum of a Record.

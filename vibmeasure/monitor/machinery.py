@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core import units as _units
-from ..core._validate import as_record, clean_signal, positive, response_channel
+from ..core._validate import as_record, clean_signal, memory_guard, positive, response_channel
 from ..core.errors import ParameterError
 from ..models.bearing import Bearing, Gear, bearing_from
 from .bearing_faults import FAMILIES, bearing_evidence
@@ -327,6 +327,7 @@ def _p_none(table) -> float:
     return p
 
 
+@memory_guard
 def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_group: int | None = None,
              foundation: str | None = None, channel=None, channels=None, band=None,
              prewhitening=("cepstral",), line_frequency: float | None = None,

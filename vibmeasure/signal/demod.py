@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _sig
 
-from ..core._validate import as_record, check_band, response_channel
+from ..core._validate import as_record, check_band, memory_guard, response_channel
 from ..core.errors import ParameterError
 from ..core.record import Channel, Record
 from ..core.results import Spectrum
@@ -23,6 +23,7 @@ def _band(rec, band):
     return lo, hi
 
 
+@memory_guard
 def envelope(rec, *, band, channel=None, order: int = 4, fs: float | None = None) -> Record:
     """Envelope of one channel: zero-phase Butterworth band-pass, then |analytic signal|."""
     rec = as_record(rec, fs=fs)
@@ -40,6 +41,7 @@ def envelope(rec, *, band, channel=None, order: int = 4, fs: float | None = None
                   meta=rec.meta, history=rec.history + (f"envelope(band=({lo:g}, {hi:g}))",))
 
 
+@memory_guard
 def envelope_spectrum(rec, *, band, channel=None, window="hann", nperseg: int | None = None,
                       fs: float | None = None, progress=None) -> Spectrum:
     """Amplitude spectrum of the squared envelope (mean removed) of the band-passed channel.

@@ -13,7 +13,7 @@ import numpy as np
 from scipy import signal as _sig
 
 from ..core import units as _units
-from ..core._validate import as_record, check_band, positive
+from ..core._validate import as_record, check_band, memory_guard, positive
 from ..core.errors import ParameterError
 from ..core.record import Channel, Record
 
@@ -99,6 +99,7 @@ def _si(rec: Record, i: int) -> tuple[np.ndarray, Channel]:
     return x, c
 
 
+@memory_guard
 def integrate(rec, *, method: str = "frequency", highpass: float = DEFAULT_HIGHPASS_HZ, channels=None,
               fs: float | None = None) -> Record:
     """Acceleration -> velocity, velocity -> displacement, in SI units (g becomes m/s^2 first).
@@ -112,6 +113,7 @@ def integrate(rec, *, method: str = "frequency", highpass: float = DEFAULT_HIGHP
     return _calculus(rec, +1, method, highpass, channels, fs)
 
 
+@memory_guard
 def differentiate(rec, *, method: str = "frequency", channels=None, fs: float | None = None) -> Record:
     """Displacement -> velocity, velocity -> acceleration, in SI units (frequency domain: X(f) i 2 pi f,
     or central differences with ``method="time"``)."""

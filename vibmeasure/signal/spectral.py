@@ -15,7 +15,7 @@ import numpy as np
 import scipy.fft as _fft
 from scipy import signal as _sig
 
-from ..core._validate import select_names
+from ..core._validate import memory_guard, select_names
 from ..core.errors import ParameterError
 from ..core.record import Record
 from ..core.results import Spectrogram, Spectrum
@@ -247,6 +247,7 @@ def _meta(src, idx):
 
 
 # ------------------------------------------------------------------------------------------------
+@memory_guard
 def psd(rec, *, nperseg: int | None = None, noverlap: int | None = None, window="hann", detrend="constant",
         average: str = "mean", scaling: str = "density", nfft: int | None = None, channels=None,
         fs: float | None = None, progress: Callable[[float], None] | None = None) -> Spectrum:
@@ -278,6 +279,7 @@ def psd(rec, *, nperseg: int | None = None, noverlap: int | None = None, window=
                      "n_averages": nseg, "enbw_hz": enbw, "scaling": scaling})
 
 
+@memory_guard
 def amplitude_spectrum(rec, *, window="hann", nfft: int | None = None, scaling: str = "peak",
                        nperseg: int | None = None, noverlap: int | None = None, average: str = "mean",
                        detrend="constant", channels=None, fs: float | None = None,
@@ -351,6 +353,7 @@ def coherence(rec, x, y, *, nperseg: int | None = None, noverlap: int | None = N
                     dict(p, window=window, detrend=detrend, fs=src.fs, n_averages=nseg))
 
 
+@memory_guard
 def spectrogram(rec, *, channel=None, nperseg: int | None = None, noverlap: int | None = None, window="hann",
                 detrend="constant", nfft: int | None = None, fs: float | None = None) -> Spectrogram:
     """Power spectral density of each segment over time (a waterfall): values (1, n_freq, n_times)."""
