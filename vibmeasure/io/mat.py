@@ -149,6 +149,7 @@ def read_mat(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
         if not rows:
             raise ParameterError(f"{src}: no signal matches the time vector's length {n_star}")
     n = len(rows[0])
+    check_size(n * len(rows), source=src, max_samples=max_samples)   # struct fields: whosmat did not see them
     data = np.vstack([np.asarray(x, dtype=np.float64) for x in rows])
 
     # the sampling rate
