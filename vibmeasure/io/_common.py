@@ -140,6 +140,10 @@ def atomic_path(path: str | os.PathLike):
             break
         except FileExistsError:
             continue
+        except OSError as exc:
+            raise ParameterError(f"path={str(path)!r}: cannot write in {str(path.parent)!r} ({exc.strerror})") from None
+    else:
+        raise ParameterError(f"path={str(path)!r}: no free temporary name beside it")
     os.close(fd)
     try:
         yield Path(tmp)
