@@ -61,3 +61,11 @@ def test_envelope_spectrum_of_a_lazy_record_is_streamed_and_exact(tmp_path):
     assert s.params["streamed"] and s.params["averages"] == 39 and seen[-1] == 1.0
     mem = vm.envelope_spectrum(vm.read(p), band=(2000, 3000), nperseg=20000)   # the in-memory path agrees on the line
     assert mem.values[0][np.argmin(np.abs(mem.freq - 50))] == pytest.approx(2 * m * A ** 2, rel=1e-3)
+
+
+def test_streamed_envelope_refuses_a_bad_nperseg(tmp_path):
+    import vibmeasure as vm
+    p = vm.write(tmp_path / "r.h5", vm.Record.from_array(np.sin(np.arange(5000.0)), fs=1000.0))
+    for bad, match in (("x", "integer"), (100, "at least 256")):
+        with pytest.raises(vm.ParameterError, match=match):
+            vm.envelope_spectrum(vm.open(p), band=(100, 300), nperseg=bad)

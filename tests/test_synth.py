@@ -80,3 +80,10 @@ def test_clip_offset_drift():
 def test_free_decay_bad_input(kw, msg):
     with pytest.raises(vm.ParameterError, match=msg):
         vm.synth.free_decay(fs=100.0, duration=1.0, **kw)
+
+
+def test_machine_nuisance_arguments_are_checked():
+    for kw, match in ((dict(shaft_impacts=float("nan")), "shaft_impacts"), (dict(shaft_impacts=-1.0), "shaft_impacts"),
+                      (dict(cage_modulation="a"), "cage_modulation"), (dict(cage_modulation=1.5), "cage_modulation")):
+        with pytest.raises(vm.ParameterError, match=match):
+            vm.synth.machine(duration=1.0, **kw)

@@ -320,13 +320,13 @@ def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, du
     sig = severity * sig
     p_sig = np.mean(sig ** 2) if fault != "none" else np.mean((0.3 * np.ones(1)) ** 2) / 2
     noise = rng.normal(0, np.sqrt(p_sig / 10 ** (snr_db / 10)), n)
-    if not 0 <= cage_modulation <= 1:
+    cage_modulation = positive(cage_modulation, "cage_modulation", allow_zero=True)
+    if cage_modulation > 1:
         raise ParameterError(f"{cage_modulation=} must be between 0 and 1 (modulation depth)")
     if cage_modulation:
         th = 2 * np.pi * b.frequencies(f1)["FTF"] * t + rng.uniform(0, 2 * np.pi)
         noise *= 1 + cage_modulation * (np.cos(th) + 0.5 * np.cos(2 * th) + 0.3 * np.cos(3 * th)) / 1.8
-    if shaft_impacts < 0:
-        raise ParameterError(f"{shaft_impacts=} must be >= 0")
+    shaft_impacts = positive(shaft_impacts, "shaft_impacts", allow_zero=True)
     if shaft_impacts:
         sig = sig + shaft_impacts * np.sqrt(2 * p_sig) * _impact_train(n, fs, np.arange(rng.uniform(0, 1 / f1),
                                                                                        duration, 1 / f1),

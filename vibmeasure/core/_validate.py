@@ -28,6 +28,7 @@ def memory_guard(func):
                                  "channels=...), decimate it, or stream it with vm.open and nperseg") from None
     return wrapper
 
+
 # amplitudes whose squares (powers, spectra, likelihoods) stay inside double precision
 RANGE = (1e-150, 1e150)
 

@@ -97,7 +97,7 @@ def read_frf(path: str | os.PathLike, *, variable: str | None = None, fs: float 
         raise ParameterError(f"path={str(path)!r} does not exist")
     ext = p.suffix.lower()
     if ext in (".uff", ".unv"):
-        return guarded(lambda q: read_frf_uff(q), p)
+        return guarded(read_frf_uff, p)
     if ext == ".mat":
         import numpy as np
         from .mat import _leaves_v5
@@ -128,4 +128,4 @@ def read_spectrum(path: str | os.PathLike):
         raise ParameterError(f"path={str(path)!r} does not exist")
     if p.suffix.lower() != ".lvm":
         raise ParameterError(f"path={str(path)!r}: spectra are read from LabVIEW .lvm exports, not {p.suffix!r}")
-    return guarded(lambda q: read_lvm_spectrum(q), p)
+    return guarded(read_lvm_spectrum, p)

@@ -74,6 +74,8 @@ def _envelope_spectrum_streamed(rec, *, band, channel, nperseg, progress):
     lo, hi = _band(rec, band)
     i = response_channel(rec, channel) if hasattr(rec, "data") else (rec.index(channel) if channel is not None else 0)
     n = rec.n_samples
+    if nperseg is not None and (isinstance(nperseg, bool) or not isinstance(nperseg, (int, np.integer))):
+        raise ParameterError(f"nperseg={nperseg!r} must be an integer number of samples")
     seg = min(n, 2 ** 18 if nperseg is None else int(nperseg))
     if seg < 256:
         raise ParameterError(f"nperseg={nperseg!r} must be at least 256 samples (and at most the record)")
