@@ -32,11 +32,15 @@ def clipped_mask(x: np.ndarray) -> np.ndarray:
 
 
 def noise_std(x: np.ndarray, fs: float) -> float:
-    """Broadband noise std from the median level of a Welch PSD (robust to sparse spectral lines)."""
+    """Broadband noise std from the median level of a Welch PSD (robust to sparse spectral lines).
+
+    Segments of at most 4096 samples, each linearly detrended and Hann-windowed, half overlapping;
+    processed a block of segments at a time, so memory stays bounded for any record length.
+    """
     n = x.size
     nper = int(min(n, max(64, 2 ** int(np.log2(max(n // 16, 64))))))
     nper = min(nper, 4096)
-    f, p = _sig.welch(x, fs=fs, nperseg=nper, detrend="linear")
+    p = _welch_linear(x, fs, nper)
     p = p[1:-1] if p.size > 4 else p
     segs = max(1, 2 * n // nper - 1)
     # median of an average of K chi^2_2 variables: mean * (1 - 2/(9K))^3 (Wilson-Hilferty)
@@ -45,10 +49,50 @@ def noise_std(x: np.ndarray, fs: float) -> float:
     level = np.median(p) / med_to_mean
     welch_std = float(np.sqrt(level * fs / 2))
     # a record that has decayed ends in noise alone: its last tenth, detrended, is the noise
-    tail = x[-max(16, n // 10):]
-    k = np.arange(tail.size)
-    tail_std = float(np.std(tail - np.polyval(np.polyfit(k, tail, 1), k)))
+    tail_std = float(np.std(detrend_linear(x[-max(16, n // 10):])))
     return min(welch_std, tail_std)
+
+
+def detrend_linear(x: np.ndarray) -> np.ndarray:
+    """x less its least-squares straight line (closed form: no Vandermonde matrix)."""
+    n = x.size
+    if n < 2:
+        return x - x.mean() if n else x.copy()
+    k = np.arange(n, dtype=float) - (n - 1) / 2
+    slope = float(k @ x) / float(k @ k)
+    return x - x.mean() - slope * k
+
+
+def _welch_linear(x: np.ndarray, fs: float, nper: int) -> np.ndarray:
+    """One-sided Welch PSD (Hann, 50 % overlap, linear detrend per segment) in bounded memory.
+
+    Same estimate as ``scipy.signal.welch(x, fs, nperseg=nper, detrend="linear")``; the detrend is
+    a projection on an orthonormal (1, k) basis, done for a block of segments at once.
+    """
+    x = np.asarray(x, float)
+    if x.size <= nper:
+        nper = x.size
+    step = max(1, nper // 2)
+    nseg = (x.size - nper) // step + 1
+    win = _sig.get_window("hann", nper)
+    k = np.arange(nper, dtype=float)
+    q1 = np.full(nper, 1 / np.sqrt(nper))
+    q2 = k - k.mean()
+    q2 /= np.sqrt(q2 @ q2) if nper > 1 else 1.0
+    acc = np.zeros(nper // 2 + 1)
+    segs = np.lib.stride_tricks.as_strided(x, shape=(nseg, nper), strides=(x.strides[0] * step, x.strides[0]),
+                                           writeable=False)
+    blk = max(1, (1 << 21) // nper)
+    for s0 in range(0, nseg, blk):
+        b = segs[s0:s0 + blk]
+        b = b - np.outer(b @ q1, q1) - np.outer(b @ q2, q2)
+        acc += np.sum(np.abs(np.fft.rfft(b * win, axis=1)) ** 2, axis=0)
+    p = acc / (nseg * fs * (win @ win))
+    if nper % 2 == 0:
+        p[1:-1] *= 2
+    else:
+        p[1:] *= 2
+    return p
 
 
 def decay_start(rec: Record, idx: int, x: np.ndarray) -> tuple[int, str]:
@@ -102,7 +146,7 @@ def extremes(x: np.ndarray, fs: float, fd: float) -> tuple[np.ndarray, np.ndarra
 
     Extremes are searched between zero crossings of the signal less its one-period moving
     average (with hysteresis against noise-born crossings) and refined by a least-squares
-    parabola over +-0.1 period.
+    parabola over +-0.1 period. Vectorised: the only loop runs once per kept half cycle.
     """
     per = fs / fd
     if not np.isfinite(per) or per > x.size / 3 or per < 2:
@@ -110,33 +154,49 @@ def extremes(x: np.ndarray, fs: float, fd: float) -> tuple[np.ndarray, np.ndarra
     base = uniform_filter1d(x, size=max(3, int(round(per))), mode="nearest")
     y = x - base
     h = max(1, int(round(0.1 * per)))
-    zc = np.flatnonzero(np.diff(np.sign(y)) != 0)
+    zc = np.flatnonzero(np.diff(np.signbit(y)))
     if zc.size < 3:
         return np.empty(0), np.empty(0)
-    keep = [zc[0]]
-    for z in zc[1:]:
-        if z - keep[-1] >= 0.3 * per:
-            keep.append(z)
-    zc = np.asarray(keep)
+    # hysteresis: a crossing counts only 0.3 period after the last one kept (noise-born crossings
+    # near zero are skipped by a binary search, not visited one by one)
+    gap = 0.3 * per
+    zf = zc.astype(float)  # searched with a float key: no cast of the whole array per search
+    keep = [zf[0]]
+    while True:
+        j = int(zf.searchsorted(keep[-1] + gap))
+        if j >= zf.size:
+            break
+        keep.append(zf[j])
+    zc = np.asarray(keep, dtype=np.int64)
+    if zc.size < 2:
+        return np.empty(0), np.empty(0)
+    # the largest |y| between consecutive kept crossings: a segment-wise argmax, done a block of
+    # segments at a time so the index arrays stay small
+    ay = np.abs(y)
+    i = np.concatenate([_segment_argmax(ay, zc[j0:j0 + 4097] + 1) for j0 in range(0, zc.size - 1, 4096)])
+    i = i[(i - h >= 0) & (i + h < y.size)]
+    if i.size == 0:
+        return np.empty(0), np.empty(0)
     u = np.arange(-h, h + 1, dtype=float)
     pinv = np.linalg.pinv(np.vstack([np.ones_like(u), u, u * u]).T)
-    tk, vk = [], []
-    for a, b in zip(zc[:-1], zc[1:]):
-        seg = y[a + 1:b + 1]
-        if seg.size == 0:
-            continue
-        i = a + 1 + int(np.argmax(np.abs(seg)))
-        if i - h < 0 or i + h >= y.size:
-            continue
-        c0, c1, c2 = pinv @ x[i - h:i + h + 1]
-        if c2 == 0:
-            continue
+    c0, c1, c2 = pinv @ x[i[None, :] + np.arange(-h, h + 1)[:, None]]
+    with np.errstate(divide="ignore", invalid="ignore"):
         du = -c1 / (2 * c2)
-        if abs(du) > h:
-            continue
-        tk.append((i + du) / fs)
-        vk.append(c0 - c1 * c1 / (4 * c2))
-    return np.asarray(tk), np.asarray(vk)
+        v = c0 - c1 * c1 / (4 * c2)
+    ok = (c2 != 0) & (np.abs(du) <= h)
+    return (i[ok] + du[ok]) / fs, v[ok]
+
+
+def _segment_argmax(v: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Index of the (first) largest v in each [edges[j], edges[j+1]); the segments are contiguous
+    and non-empty. Linear: a reduceat for the maxima, one comparison pass for their places."""
+    a0, b1 = int(edges[0]), int(edges[-1])
+    lens = np.diff(edges)
+    seg_max = np.maximum.reduceat(v[a0:b1], edges[:-1] - a0)
+    hit = np.flatnonzero(v[a0:b1] == np.repeat(seg_max, lens))
+    seg = np.searchsorted(edges[1:] - a0, hit, side="right")
+    first = np.r_[True, seg[1:] != seg[:-1]]
+    return hit[first] + a0
 
 
 def cycle_peaks(x: np.ndarray, fs: float, fd: float) -> tuple[np.ndarray, np.ndarray]:
@@ -163,20 +223,76 @@ def spectral_peak(x: np.ndarray, fs: float, band=None) -> float:
     """Frequency of the strongest spectral line, optionally inside a band (a start value).
 
     No taper: a decay is its own window, and a Hann taper would hide a decay that is over in
-    the first part of the record.
+    the first part of the record. The line is found on the unpadded spectrum, then located by a
+    log-parabola through the DTFT sampled at a quarter bin around it (what a 4x zero-padded FFT
+    gives, without its memory).
     """
     n = x.size
+    y = detrend_linear(x)  # offset and drift out
     nfft = int(2 ** np.ceil(np.log2(max(4 * n, 1024))))
-    k = np.arange(n)
-    X = np.abs(np.fft.rfft(x - np.polyval(np.polyfit(k, x, 1), k), nfft))  # offset and drift out
-    f = np.fft.rfftfreq(nfft, 1 / fs)
-    sel = np.ones_like(f, bool) if band is None else (f >= band[0]) & (f <= band[1])
-    sel &= f >= 2 * fs / n  # at least two cycles in the record
+    f_lo = 2 * fs / n  # at least two cycles in the record
+    lo, hi = (f_lo, fs / 2) if band is None else (max(band[0], f_lo), band[1])
+    if lo > hi:
+        lo, hi = 1e-300, fs / 2
+    m = n if n >= 256 else 256
+    X = np.abs(np.fft.rfft(y, m))
+    f = np.fft.rfftfreq(m, 1 / fs)
+    sel = (f >= lo) & (f <= hi)
     if not sel.any():
         sel = f > 0
-    k = np.flatnonzero(sel)[np.argmax(X[sel])]
-    if 0 < k < X.size - 1:
-        a, b, c = np.log(X[k - 1:k + 2] + 1e-300)
-        d = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) != 0 else 0.0
-        return float((k + d) * fs / nfft)
-    return float(f[k])
+    # the five strongest coarse maxima are refined: two lines of nearly equal height may swap
+    # order between the coarse and the fine grid
+    idx = np.flatnonzero(sel)
+    Xs = X[idx]
+    loc = np.flatnonzero(np.r_[True, Xs[1:] >= Xs[:-1]] & np.r_[Xs[:-1] >= Xs[1:], True])
+    cand = idx[loc[np.argsort(-Xs[loc])[:5]]]
+    best = (-1.0, 0.0)
+    for kc in cand:
+        best = max(best, _refine_peak(y, fs, float(f[kc]), m, nfft, lo, hi))
+    return best[1]
+
+
+def _refine_peak(y, fs, f0, m, nfft, lo, hi) -> tuple[float, float]:
+    """(height, frequency) of the line near f0 on the quarter-bin grid of the padded FFT.
+
+    The grid window follows the maximum when it sits on the window's edge (noise can move a broad
+    peak's top away from the coarse maximum).
+    """
+    gmax = nfft // 2
+    g_lo, g_hi = int(np.ceil(lo * nfft / fs)), int(np.floor(hi * nfft / fs))
+    if g_lo > g_hi:
+        g_lo, g_hi = 0, gmax
+    c = f0 * nfft / fs
+    half = 1.5 * nfft / m
+    for _ in range(8):
+        g = np.arange(max(np.floor(c - half), g_lo, 0), min(np.ceil(c + half), g_hi, gmax) + 1)
+        D = np.abs(_dtft(y, g / nfft))
+        j = int(np.argmax(D))
+        if (j == 0 and g[0] > max(g_lo, 0)) or (j == D.size - 1 and g[-1] < min(g_hi, gmax)):
+            c = g[j]
+            continue
+        break
+    if 0 < j < D.size - 1:
+        a, b, cc = np.log(D[j - 1:j + 2] + 1e-300)
+        d = 0.5 * (a - cc) / (a - 2 * b + cc) if (a - 2 * b + cc) != 0 else 0.0
+        return float(D[j]), float((g[j] + d) * fs / nfft)
+    return float(D[j]), float(g[j] * fs / nfft)
+
+
+def _dtft(y: np.ndarray, nu: np.ndarray, chunk: int = 1 << 14) -> np.ndarray:
+    """sum_k y[k] exp(-2 pi i nu k) at a few normalised frequencies ``nu``, in bounded memory.
+
+    One kernel exp(-2 pi i nu j), j < chunk, serves every chunk through its start phase.
+    """
+    # the kernel as an outer product of two short ones (j = 128 j1 + j2): 256 exponentials per
+    # frequency instead of one per sample
+    B = 128
+    chunk = B * max(1, min(chunk, y.size + B - 1) // B)
+    hi = np.exp(-2j * np.pi * np.outer(nu, B * np.arange(chunk // B)))
+    lo = np.exp(-2j * np.pi * np.outer(nu, np.arange(B)))
+    E = (hi[:, :, None] * lo[:, None, :]).reshape(nu.size, chunk)
+    out = np.zeros(nu.size, complex)
+    for s0 in range(0, y.size, chunk):
+        seg = y[s0:s0 + chunk]
+        out += np.exp(-2j * np.pi * nu * s0) * (E[:, :seg.size] @ seg)
+    return out

@@ -148,39 +148,41 @@ def _linear_amplitudes(x, w, t, sig, om, tn):
 # ---------------------------------------------------------------------------------------------
 # nonlinear least squares (Levenberg-Marquardt, chunked so memory stays bounded)
 def _evaluate(p, x, w, t, tn, nm, want_model=False):
+    from scipy.linalg.blas import dsyrk
     P = p.size
     JtJ = np.zeros((P, P))
     Jtr = np.zeros(P)
     rss = 0.0
     model_all = np.empty_like(x) if want_model else None
+    weighted = not w.all()
     for s0 in range(0, x.size, CHUNK):
         s1 = min(s0 + CHUNK, x.size)
         tt = t[s0:s1]
-        J = np.empty((s1 - s0, P))
+        J = np.empty((P, s1 - s0))  # row-major by parameter: each column write is contiguous
         model = p[-2] + p[-1] * tn[s0:s1]
         for k in range(nm):
             sg, om, a, b = p[4 * k:4 * k + 4]
-            e = np.exp(-sg * tt)
-            c = np.cos(om * tt) * e
-            sn = np.sin(om * tt) * e
+            z = np.exp(np.multiply.outer(tt, complex(-sg, om)))  # e^(-sg t) (cos + i sin)
+            c, sn = z.real, z.imag
             mk = a * c + b * sn
             model += mk
-            J[:, 4 * k] = -tt * mk
-            J[:, 4 * k + 1] = tt * (b * c - a * sn)
-            J[:, 4 * k + 2] = c
-            J[:, 4 * k + 3] = sn
-        J[:, -2] = 1.0
-        J[:, -1] = tn[s0:s1]
+            np.multiply(-tt, mk, out=J[4 * k])
+            np.multiply(tt, b * c - a * sn, out=J[4 * k + 1])
+            J[4 * k + 2] = c
+            J[4 * k + 3] = sn
+        J[-2] = 1.0
+        J[-1] = tn[s0:s1]
         r = x[s0:s1] - model
-        ww = w[s0:s1]
-        if not ww.all():
+        if weighted:
+            ww = w[s0:s1]
             r = r * ww
-            J *= ww[:, None]
-        JtJ += J.T @ J
-        Jtr += J.T @ r
+            J *= ww
+        JtJ += dsyrk(1.0, J.T, trans=1, lower=0)  # J J' without a copy (J.T is Fortran-ordered)
+        Jtr += J @ r
         rss += float(r @ r)
         if want_model:
             model_all[s0:s1] = model
+    JtJ = np.triu(JtJ) + np.triu(JtJ, 1).T
     return rss, JtJ, Jtr, model_all
 
 
@@ -190,22 +192,29 @@ def _lm(p, x, w, t, tn, nm, max_iter=80):
 
 
 def _lm_inner(p, x, w, t, tn, nm, max_iter):
+    """Levenberg-Marquardt with Nielsen's damping update (the damping follows the ratio of the
+    actual to the predicted gain, so it neither bounces nor stalls in the long valleys that a
+    slow baseline component makes with the offset and drift terms)."""
     sig_min = -1.0 / max(t[-1], 1e-300)  # a mode may grow at most e-fold over the record
     rss, A, g, _ = _evaluate(p, x, w, t, tn, nm)
-    lam = 1e-4
+    lam, nu = 1e-4, 2.0
     for _ in range(max_iter):
         d = np.sqrt(np.diag(A)) + 1e-300
         An = A / np.outer(d, d)
         try:
-            step = np.linalg.solve(An + lam * np.eye(p.size), g / d) / d
+            hn = np.linalg.solve(An + lam * np.eye(p.size), g / d)
         except np.linalg.LinAlgError:
-            lam *= 10
+            lam *= nu
+            nu *= 2
             continue
+        step = hn / d
         pn = p + step
         if nm:
             pn[1:4 * nm:4] = np.abs(pn[1:4 * nm:4])
             pn[0:4 * nm:4] = np.maximum(pn[0:4 * nm:4], sig_min)
         rss_n, An_, gn, _ = _evaluate(pn, x, w, t, tn, nm)
+        # predicted gain of the damped Gauss-Newton step (scaled variables): h'(lam h + g)
+        pred = float(hn @ (lam * hn + g / d))
         if np.isfinite(rss_n) and np.all(np.isfinite(gn)) and rss_n <= rss:
             small = True
             for k in range(nm):
@@ -214,20 +223,32 @@ def _lm_inner(p, x, w, t, tn, nm, max_iter):
                 small &= abs(step[4 * k]) < 1e-13 * om and abs(step[4 * k + 1]) < 1e-13 * om
                 small &= abs(step[4 * k + 2]) < 1e-11 * amp and abs(step[4 * k + 3]) < 1e-11 * amp
             gain = rss - rss_n
+            rho = gain / pred if pred > 0 else 0.0
             p, rss, A, g = pn, rss_n, An_, gn
-            lam = max(lam / 10, 1e-15)
+            lam = max(lam * max(1 / 3, 1 - (2 * rho - 1) ** 3), 1e-15)
+            nu = 2.0
             if small or gain <= 1e-15 * rss:
                 break
-            # Newton decrement: what a further Gauss-Newton step could still gain; below a
-            # millionth of one noise variance the parameters move by < 1e-3 of their std
+            # converged when the last step moved every decay rate and frequency by under 1e-3 of
+            # its std, or when the Newton decrement (what a further Gauss-Newton step could still
+            # gain) is below a millionth of one noise variance
+            s2 = rss / max(x.size - p.size, 1)
             try:
+                Ainv_d = np.diag(np.linalg.inv(A))
                 dec = float(g @ np.linalg.solve(A, g))
             except np.linalg.LinAlgError:
-                dec = np.inf
-            if dec < 1e-6 * rss / max(x.size - p.size, 1):
+                Ainv_d, dec = np.full(p.size, np.inf), np.inf
+            # (baseline wander, under two cycles in the span, is a nuisance: its slow crawl along
+            # the valley it forms with the drift term does not move the modes)
+            osc = [k for k in range(nm) if abs(p[4 * k + 1]) * t[-1] >= 4 * np.pi]
+            nl_idx = np.r_[[4 * k for k in osc], [4 * k + 1 for k in osc]].astype(int)
+            if osc and np.all(np.abs(step[nl_idx]) < 1e-3 * np.sqrt(np.maximum(s2 * Ainv_d[nl_idx], 0))):
+                break
+            if dec < 1e-6 * s2:
                 break
         else:
-            lam *= 10
+            lam *= nu
+            nu *= 2
             if lam > 1e12:
                 break
     return p, rss, A
@@ -291,7 +312,7 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         i0, how = decay_start(rec, idx, x_all)
         if i0 > 0:
             flags.append("start_detected")
-    x = x_all[i0:]
+    x = _trim_early(x_all[i0:], fsr, flags)
     clip = clipped_mask(x)
     if clip.any():
         flags.append("clipped")
@@ -301,13 +322,15 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         raise FitError("almost every sample is clipped: nothing left to fit")
 
     # --- dry friction: a linear envelope is not a sum of damped sinusoids --------------------
-    if (~clip).all():
-        coul = _coulomb_check(x, fsr, rec, idx, flags, i0, how)
+    # (the dominant line, the noise and the cycle amplitudes are computed once for both checks)
+    pre = _dominant_cycles(x, fsr) if (~clip).all() else None
+    if pre is not None:
+        coul = _coulomb_check(x, fsr, rec, idx, flags, i0, how, pre)
         if coul is not None:
             return coul
 
     # --- damping that changes with amplitude: one mode, described by a table ------------------
-    nl_pre = _amplitude_check(x, fsr, band) if (~clip).all() else {}
+    nl_pre = _amplitude_check(x, fsr, band, pre) if pre is not None else {}
     if nl_pre.get("amplitude_dependent") and n_modes is None:
         # a sum of close 'modes' would mimic the non-exponential envelope: fit one mode instead
         n_modes = 1
@@ -371,7 +394,7 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     if noise0 and decaying.all():
         t_floor = np.max(np.log(np.maximum(env_amp / (0.3 * noise0), 1.0)) / sig0)
         n_end = int(min(x.size, max(np.ceil(t_floor * fsr) + 1, 64)))
-        if n_end < x.size:
+        if n_end < x.size and "noise_floor" not in flags:
             flags.append("noise_floor")
     x, w, t = x[:n_end], w[:n_end], t[:n_end]
     T = t[-1] if t[-1] > 0 else 1.0
@@ -399,6 +422,10 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
                 share[k] = float(p[g_] @ np.linalg.solve(Ainv[np.ix_(g_, g_)], p[g_]))
             except np.linalg.LinAlgError:
                 share[k] = 0.0
+        # baseline wander (under two cycles in the span) is collinear with the offset and drift, so
+        # its Wald share is small however much of the record it carries: it is not a candidate
+        wander_k = np.abs(p[1:4 * nm:4]) * t[-1] < 4 * np.pi
+        share[wander_k] = np.inf
         weak = share <= DETECT * s2
         if not weak.any() or nm == 1:
             break
@@ -535,6 +562,36 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     return est
 
 
+def _trim_early(x, fs, flags):
+    """Cut a long record where its decay has long sunk into the noise, before any full-record work.
+
+    The envelope is the RMS of 256-sample blocks; the last block above 1.5 x the noise std (11
+    standard errors of a noise block) is where the slowest component is about 1.6 x the noise.
+    The cut leaves the time that component needs, at the rate implied by the first block, to fall
+    on to 0.3 x the noise (where the fit's own trim stops), plus 20 %. Tones that never decay keep
+    the whole record.
+    """
+    nb = 256
+    if x.size < 64 * nb:
+        return x
+    nblk = x.size // nb
+    rms = np.sqrt(np.mean((x[:nblk * nb].reshape(nblk, nb) - np.median(x)) ** 2, axis=1))
+    noise = noise_std(x, fs)
+    if noise <= 0:
+        return x
+    above = np.flatnonzero(rms > 1.5 * noise)
+    if above.size == 0:
+        return x
+    t1 = (above[-1] + 1) * nb
+    a0 = np.sqrt(2) * float(rms.max())
+    per_tau = np.log(max(a0 / (1.6 * noise), np.e ** 0.5))  # time constants from the peak to t1
+    n_end = int(1.2 * t1 * (1 + np.log(1.6 / 0.3) / per_tau)) + 4 * nb
+    if n_end >= 0.8 * x.size:
+        return x
+    flags.append("noise_floor")
+    return x[:n_end]
+
+
 def _pack(sig, om, a, b):
     p = np.empty(4 * sig.size + 2)
     p[0:-2:4], p[1:-2:4], p[2:-2:4], p[3:-2:4] = sig, om, a, b
@@ -649,7 +706,14 @@ def _nonlinear_damping(x, fs, fd, noise, t_end):
     return out
 
 
-def _amplitude_check(x, fs, band):
+def _dominant_cycles(x, fs):
+    """The strongest line, the broadband noise and the cycle-amplitude analysis at that line."""
+    fd0 = spectral_peak(x, fs)
+    noise = noise_std(x, fs)
+    return {"fd": fd0, "noise": noise, "nl": _nonlinear_damping(x, fs, fd0, noise, t_end=x.size / fs)}
+
+
+def _amplitude_check(x, fs, band, pre):
     """Damping versus amplitude from the cycle amplitudes of the dominant (or in-band) mode.
 
     Runs only where one mode dominates: the band's signal (band-passed, the filter's ringing
@@ -665,23 +729,25 @@ def _amplitude_check(x, fs, band):
         skip = int(min(y.size // 4, 7 * fs / r_min))
         y = y[skip:]
         fd = spectral_peak(y, fs, band)
+        out = _nonlinear_damping(y, fs, fd, noise_std(y, fs), t_end=y.size / fs)
     else:
-        fd = spectral_peak(y, fs)
+        # the cycle amplitudes and the noise do not depend on the offset: the shared analysis serves
+        fd = pre["fd"]
         P = np.abs(np.fft.rfft(y)) ** 2
         f = np.fft.rfftfreq(y.size, 1 / fs)
         near = (f > 0.8 * fd) & (f < 1.2 * fd)
         if P[near].sum() < 0.8 * P[1:].sum():
             return {}
-    out = _nonlinear_damping(y, fs, fd, noise_std(y, fs), t_end=y.size / fs)
+        out = dict(pre["nl"])
     out.pop("coulomb", None)
+    out.pop("peak_times", None)
     out["fd"] = fd
     return out
 
 
-def _coulomb_check(x, fs, rec, idx, flags, i0, how):
+def _coulomb_check(x, fs, rec, idx, flags, i0, how, pre):
     """A single-mode decay whose cycle amplitudes fall linearly: report Coulomb friction."""
-    fd0 = spectral_peak(x, fs)
-    nl = _nonlinear_damping(x, fs, fd0, noise_std(x, fs), t_end=x.size / fs)
+    fd0, nl = pre["fd"], pre["nl"]
     if not nl.get("coulomb"):
         return None
     tp = nl["peak_times"]
