@@ -380,10 +380,13 @@ def _spectrum(args, out, err):
     from .signal import demod, peaks as pk, spectral
     p = Path(args.file)
     if p.suffix.lower() in (".h5", ".hdf5") and args.fs is None:
+        check = _Progress(err, "verifying checksum")
         try:
-            rec = io.open_record(p, unit=args.unit)
+            rec = io.open_record(p, unit=args.unit, progress=check)
         except VibMeasureError:
             rec = io.read(p, fs=args.fs, unit=args.unit)
+        finally:
+            check.close()
     else:
         rec = io.read(p, fs=args.fs, unit=args.unit)
     chans = args.channel

@@ -8,7 +8,42 @@ from .errors import ParameterError
 from .record import Record
 
 __all__ = ["as_record", "response_channel", "clean_signal", "check_band", "positive", "name_index",
-           "select_names", "check_range", "memory_guard"]
+           "select_names", "check_range", "memory_guard", "check_memory"]
+
+
+def available_memory() -> float:
+    """Bytes this process can still allocate: the smaller of the system's available memory
+    (MemAvailable) and the address-space limit (ulimit -v) less what is mapped already; inf
+    when neither is known."""
+    avail = np.inf
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    avail = float(line.split()[1]) * 1024
+                    break
+    except OSError:
+        pass
+    try:
+        import resource
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+        if soft not in (resource.RLIM_INFINITY, -1):
+            with open("/proc/self/statm") as fh:
+                mapped = float(fh.read().split()[0]) * resource.getpagesize()
+            avail = min(avail, soft - mapped)
+    except (OSError, ValueError, ImportError, IndexError):
+        pass
+    return avail
+
+
+def check_memory(nbytes: float, what: str, n_samples: int) -> None:
+    """Refuse, before allocating, work that needs more memory than the process can get, with the
+    size needed and what to do."""
+    avail = available_memory()
+    if nbytes > 0.9 * avail:
+        raise ParameterError(f"{what}: {n_samples:,} samples need about {nbytes / 2**30:.1f} GiB of working memory, "
+                             f"{max(avail, 0) / 2**30:.1f} GiB is available; cut the record (rec.slice_time) or "
+                             "decimate it (vm.decimate) first")
 
 
 def memory_guard(func):

@@ -127,6 +127,38 @@ def decay_start(rec: Record, idx: int, x: np.ndarray) -> tuple[int, str]:
     return j * nb + int(np.argmax(seg)), "after trigger"
 
 
+def trim_to_decay(x: np.ndarray, fs: float, flags: list | None = None) -> int:
+    """Length to keep of a long record whose decay has long sunk into the noise (the record is cut
+    there before any full-record work; "noise_floor" is added to ``flags`` when it is).
+
+    The envelope is the RMS of 256-sample blocks; the last block above 1.5 x the noise std (11
+    standard errors of a noise block) is where the slowest component is about 1.6 x the noise.
+    The cut leaves the time that component needs, at the rate implied by the first block, to fall
+    on to 0.3 x the noise (where the fit's own trim stops), plus 20 %. Tones that never decay keep
+    the whole record.
+    """
+    nb = 256
+    if x.size < 64 * nb:
+        return x.size
+    nblk = x.size // nb
+    rms = np.sqrt(np.mean((x[:nblk * nb].reshape(nblk, nb) - np.median(x)) ** 2, axis=1))
+    noise = noise_std(x, fs)
+    if noise <= 0:
+        return x.size
+    above = np.flatnonzero(rms > 1.5 * noise)
+    if above.size == 0:
+        return x.size
+    t1 = (above[-1] + 1) * nb
+    a0 = np.sqrt(2) * float(rms.max())
+    per_tau = np.log(max(a0 / (1.6 * noise), np.e ** 0.5))  # time constants from the peak to t1
+    n_end = int(1.2 * t1 * (1 + np.log(1.6 / 0.3) / per_tau)) + 4 * nb
+    if n_end >= 0.8 * x.size:
+        return x.size
+    if flags is not None and "noise_floor" not in flags:
+        flags.append("noise_floor")
+    return n_end
+
+
 def baseline_line(x: np.ndarray, fs: float, fd: float) -> np.ndarray:
     """Offset + drift line under an oscillation, from the midpoints of consecutive extremes.
 

@@ -8,10 +8,11 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _sig
 
-from ..core._validate import as_record, check_band, clean_signal, memory_guard, response_channel
+from ..core._validate import as_record, check_band, check_memory, clean_signal, memory_guard, response_channel
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import ModalEstimate
-from ._decay import baseline_line, clipped_mask, cycle_peaks, decay_start, noise_std, spectral_peak
+from ._decay import (baseline_line, clipped_mask, cycle_peaks, decay_start, detrend_linear, noise_std, spectral_peak,
+                     trim_to_decay)
 
 __all__ = ["log_decrement", "hilbert_decay", "half_power", "zeta_from_delta"]
 
@@ -27,9 +28,13 @@ def zeta_from_delta(delta):
     return delta / np.sqrt(4 * np.pi ** 2 + delta ** 2)
 
 
-def _prepare(rec, channel, band, start, fs):
+def _prepare(rec, channel, band, start, fs, *, trim=False, work=8):
+    """Channel, decay start, optional band-pass; with ``trim`` the record is cut where its decay
+    has long sunk into the noise (after the band-pass when there is one: the band's own floor).
+    ``work`` is the number of record-sized arrays the caller needs, for the memory check."""
     rec = as_record(rec, fs=fs)
     idx = response_channel(rec, channel)
+    check_memory(work * 8.0 * rec.n_samples, "damping estimate", rec.n_samples)
     x = clean_signal(rec, idx, min_samples=16)
     band = check_band(band, rec.fs)
     flags = []
@@ -41,6 +46,8 @@ def _prepare(rec, channel, band, start, fs):
         if not 0 <= i0 < x.size - 16:
             raise ParameterError(f"start={start} s is outside the record (0..{rec.duration:g} s)")
     x = x[i0:]
+    if trim and band is None:
+        x = x[:trim_to_decay(x, rec.fs, flags)]
     if clipped_mask(x).any():
         flags.append("clipped")
     skip = 0
@@ -48,11 +55,12 @@ def _prepare(rec, channel, band, start, fs):
         sos = _sig.butter(4, band if band[0] > 0 else band[1], btype="bandpass" if band[0] > 0 else "lowpass",
                           fs=rec.fs, output="sos")
         # an offset or drift would make the filter ring at the band edge at both ends: remove it first
-        tt = np.arange(x.size)
-        x = _sig.sosfiltfilt(sos, x - np.polyval(np.polyfit(tt, x, 1), tt))
+        x = _sig.sosfiltfilt(sos, detrend_linear(x))
         # the filter's ringing at both ends: wait until its slowest pole has decayed by e^-7
         r_min = float(np.min(-np.log(np.abs(_sig.sos2zpk(sos)[1])))) * rec.fs
         skip = int(min(x.size // 4, 7 * rec.fs / r_min))
+        if trim:
+            x = x[:max(trim_to_decay(x, rec.fs, flags), min(x.size, 4 * skip + 64))]
     return rec, idx, x, band, flags, i0, skip
 
 
@@ -76,11 +84,17 @@ def _finish(rec, idx, method, fn, zeta, fn_std, zeta_std, flags, extras):
     return est
 
 
+def _hp_nfft(n: int) -> int:
+    """FFT length for the half-power spectrum: 16x padding, within 2^25 lines (768 MiB of spectrum)
+    for long records."""
+    return int(2 ** np.ceil(np.log2(min(16 * n, max(1 << 25, n)))))
+
+
 def _halfpower_points(x, fs, band):
     """Interpolated half-power frequencies of the strongest peak of a decay's spectrum (16x padded)."""
     n = x.size
     y = x - np.median(x[-max(8, n // 20):])
-    nfft = int(2 ** np.ceil(np.log2(16 * n)))
+    nfft = _hp_nfft(n)
     P = np.abs(np.fft.rfft(y, nfft)) ** 2
     f = np.fft.rfftfreq(nfft, 1 / fs)
     sel = np.ones_like(f, bool) if band is None else (f >= band[0]) & (f <= band[1])
@@ -128,7 +142,7 @@ def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: 
     """
     if n is not None and (isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1):
         raise ParameterError(f"n={n!r} must be None (regression) or an integer >= 1 (cycles apart)")
-    rec, idx, x, band, flags, i0, skip = _prepare(rec, channel, band, start, fs)
+    rec, idx, x, band, flags, i0, skip = _prepare(rec, channel, band, start, fs, trim=True)
     fsr = rec.fs
     fd0 = spectral_peak(x[skip: x.size - skip] if skip else x, fsr, band)  # without the filter's end effects
     x = x - baseline_line(x, fsr, fd0)  # offset and drift would shift the extremes in time
@@ -199,39 +213,41 @@ def hilbert_decay(rec, *, channel=None, band=None, start: float | None = None,
     where it lies at least 20 dB above the in-band noise, skipping the filter's end effects,
     and the damped frequency comes from the slope of the unwrapped phase.
     """
-    rec0 = as_record(rec, fs=fs)
-    idx0 = response_channel(rec0, channel)
-    x0 = clean_signal(rec0, idx0, min_samples=16)
-    b0 = check_band(band, rec0.fs)
-    fd0 = spectral_peak(x0, rec0.fs, b0)
-    if band is None:
+    rec, idx, x, _, flags, i0, _ = _prepare(rec, channel, None, start, fs, trim=True, work=10)
+    fsr = rec.fs
+    b0 = check_band(band, fsr)
+    fd0 = spectral_peak(x, fsr, b0)
+    if b0 is None:
         # wide enough for the mode's own bandwidth, so the filter rings out faster than the decay
         try:
-            f1, f2 = _halfpower_points(x0, rec0.fs, None)
+            f1, f2 = _halfpower_points(x, fsr, None)
             width = max(0.3, 5 * (f2 - f1) / fd0)
         except FitError:
             width = 0.3
-        band = (max(fd0 * (1 - width), fd0 * 0.05), min(fd0 * (1 + width), 0.49 * rec0.fs))
-    rec, idx, x, _, flags, i0, _ = _prepare(rec0, channel, None, start, None)
-    fsr = rec.fs
+        band = (max(fd0 * (1 - width), fd0 * 0.05), min(fd0 * (1 + width), 0.49 * fsr))
+    else:
+        band = b0
     bw = band[1] - band[0]
     f0 = 0.5 * (band[0] + band[1])
     # analytic signal by complex demodulation: shift f0 to DC, zero-phase low-pass to half the band,
     # shift back. Unlike an FFT Hilbert transform this is exact for a one-sided decay once the
-    # filter's own transient has died out (no 1/t tails from the abrupt start).
+    # filter's own transient has died out (no 1/t tails from the abrupt start). The envelope is
+    # 2|zb| and the phase unwrap(angle(zb)) + 2 pi f0 t: the shifted-back signal is never formed.
     t = np.arange(x.size) / fsr
     sos = _sig.butter(4, 0.5 * bw, btype="lowpass", fs=fsr, output="sos")
-    base = x * np.exp(-2j * np.pi * f0 * t)
-    zb = _sig.sosfiltfilt(sos, base.real) + 1j * _sig.sosfiltfilt(sos, base.imag)
-    z = 2 * zb * np.exp(2j * np.pi * f0 * t)
-    env = np.abs(z)
-    ph = np.unwrap(np.angle(z))
+    arg = 2 * np.pi * f0 * t
+    zb = _sig.sosfiltfilt(sos, x * np.cos(arg)) - 1j * _sig.sosfiltfilt(sos, x * np.sin(arg))
+    env = 2 * np.abs(zb)
+    ph = np.unwrap(np.angle(zb))
+    del zb
+    ph += arg
+    del arg
     # end effects: the filter's slowest pole must have died out (e^-7) and 3 cycles passed
     p_filt = _sig.sos2zpk(sos)[1]
     r_min = float(np.min(-np.log(np.abs(p_filt)))) * fsr
     skip = int(min(x.size // 4, max(3 * fsr / fd0, 7 * fsr / r_min)))
     # the analytic signal of a record that starts abruptly carries errors of about 1e-4 of the peak
-    noise_in_band = max(noise_std(x0[i0:], fsr) * np.sqrt(2 * bw / fsr), HILBERT_FLOOR * env.max())
+    noise_in_band = max(noise_std(x, fsr) * np.sqrt(2 * bw / fsr), HILBERT_FLOOR * env.max())
     ok = np.zeros(x.size, bool)
     ok[skip:x.size - skip] = True
     above = env > noise_in_band * 10 ** (ENVELOPE_DB / 20)
@@ -288,7 +304,7 @@ def half_power(obj, *, band=None, channel=None, start: float | None = None, fs: 
         return half_power_frf(obj, band=band, output=0 if channel is None else channel)
     if not isinstance(obj, (Record, np.ndarray, list, tuple)):
         raise ParameterError(f"obj must be a ring-down Record (or array with fs), got {type(obj).__name__}")
-    rec, idx, x, _, flags, i0, _ = _prepare(obj, channel, None, start, fs)
+    rec, idx, x, _, flags, i0, _ = _prepare(obj, channel, None, start, fs, work=10)
     band = check_band(band, rec.fs)   # the peak is searched in the user's band (no band-pass: it would widen it)
     fsr = rec.fs
     n = x.size
@@ -298,6 +314,8 @@ def half_power(obj, *, band=None, channel=None, start: float | None = None, fs: 
     if sigma * T < MIN_SIGMA_T:
         raise FitError(f"half_power: the record does not capture the decay (sigma*T = {sigma * T:.2f} < "
                        f"{MIN_SIGMA_T:g}): truncation widens the peak; use vm.ringdown or a longer record")
+    if (f2 - f1) * _hp_nfft(n) / fsr < 8:
+        flags.append("resolution_limited")  # under 8 spectral lines across the half-power band
     fd = 0.5 * (f1 + f2)
     if band is not None and not band[0] <= fd <= band[1]:
         raise FitError(f"half_power: the peak found ({fd:.4g} Hz) lies outside band={band}; no mode in that band")

@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core._validate import as_record, check_band, clean_signal, memory_guard, response_channel
+from ..core._validate import as_record, check_band, check_memory, clean_signal, memory_guard, response_channel
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import FLAG_TEXT, ModalEstimate
-from ._decay import clipped_mask, cycle_peaks, decay_start, noise_std, spectral_peak
+from ._decay import clipped_mask, cycle_peaks, decay_start, noise_std, spectral_peak, trim_to_decay
 from ._poles import pole_to_modal
 
 __all__ = ["ringdown", "ringdown_crb"]
@@ -198,6 +198,7 @@ def _lm_inner(p, x, w, t, tn, nm, max_iter):
     sig_min = -1.0 / max(t[-1], 1e-300)  # a mode may grow at most e-fold over the record
     rss, A, g, _ = _evaluate(p, x, w, t, tn, nm)
     lam, nu = 1e-4, 2.0
+    slow = 0
     for _ in range(max_iter):
         d = np.sqrt(np.diag(A)) + 1e-300
         An = A / np.outer(d, d)
@@ -246,6 +247,11 @@ def _lm_inner(p, x, w, t, tn, nm, max_iter):
                 break
             if dec < 1e-6 * s2:
                 break
+            # a crawl: two accepted steps in a row each gaining under 1e-5 of a noise variance
+            # move the parameters by about 3e-3 of their std
+            slow = slow + 1 if gain < 1e-5 * s2 else 0
+            if slow >= 2:
+                break
         else:
             lam *= nu
             nu *= 2
@@ -287,6 +293,7 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     """
     rec = as_record(rec, fs=fs)
     idx = response_channel(rec, channel)
+    check_memory(10 * 8.0 * rec.n_samples, "ringdown", rec.n_samples)  # about ten record-sized arrays
     x_all = clean_signal(rec, idx, min_samples=16)
     fsr = rec.fs
     band = check_band(band, fsr)
@@ -312,7 +319,8 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         i0, how = decay_start(rec, idx, x_all)
         if i0 > 0:
             flags.append("start_detected")
-    x = _trim_early(x_all[i0:], fsr, flags)
+    x = x_all[i0:]
+    x = x[:trim_to_decay(x, fsr, flags)]
     clip = clipped_mask(x)
     if clip.any():
         flags.append("clipped")
@@ -402,30 +410,27 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
 
     # --- maximum likelihood -----------------------------------------------------------------
     p = _pack(sig0, om0, a, b)
+    q = x.size // SUBSAMPLE
+    if q > 1:
+        # long record: the clearly weak components go on every q-th sample (its Fisher information
+        # is 1/q of the record's), so the full record is fitted once, with the survivors
+        for _round in range(max_modes + 2):
+            nm = (p.size - 2) // 4
+            p, rss_q, A_q = _lm(p, x[::q], w[::q], t[::q], tn[::q], nm)
+            s2_q = rss_q / max(w[::q].sum() - p.size, 1.0)
+            share = _mode_shares(p, A_q, nm, t[-1]) * q
+            if nm == 1 or not (share <= 0.25 * DETECT * s2_q).any():
+                break
+            drop = int(np.argmin(share))
+            p = np.concatenate([p[4 * k:4 * k + 4] for k in range(nm) if k != drop] + [p[-2:]])
     for _round in range(max_modes + 2):
         nm = (p.size - 2) // 4
-        q = x.size // SUBSAMPLE
         if q > 1:  # converge on every q-th sample first: the full record then needs a step or two
             p, _, _ = _lm(p, x[::q], w[::q], t[::q], tn[::q], nm)
         p, rss, A = _lm(p, x, w, t, tn, nm)
         dof = max(w.sum() - p.size, 1.0)
         s2 = max(rss / dof, (NUM_FLOOR * float(np.max(np.abs(x)))) ** 2 * 1e-6)
-        # each mode's share of the fit (Wald form on its amplitudes, from the Fisher matrix)
-        try:
-            Ainv = np.linalg.inv(A)
-        except np.linalg.LinAlgError:
-            Ainv = np.linalg.pinv(A)
-        share = np.empty(nm)
-        for k in range(nm):
-            g_ = [4 * k + 2, 4 * k + 3]
-            try:
-                share[k] = float(p[g_] @ np.linalg.solve(Ainv[np.ix_(g_, g_)], p[g_]))
-            except np.linalg.LinAlgError:
-                share[k] = 0.0
-        # baseline wander (under two cycles in the span) is collinear with the offset and drift, so
-        # its Wald share is small however much of the record it carries: it is not a candidate
-        wander_k = np.abs(p[1:4 * nm:4]) * t[-1] < 4 * np.pi
-        share[wander_k] = np.inf
+        share = _mode_shares(p, A, nm, t[-1])
         weak = share <= DETECT * s2
         if not weak.any() or nm == 1:
             break
@@ -562,34 +567,24 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     return est
 
 
-def _trim_early(x, fs, flags):
-    """Cut a long record where its decay has long sunk into the noise, before any full-record work.
-
-    The envelope is the RMS of 256-sample blocks; the last block above 1.5 x the noise std (11
-    standard errors of a noise block) is where the slowest component is about 1.6 x the noise.
-    The cut leaves the time that component needs, at the rate implied by the first block, to fall
-    on to 0.3 x the noise (where the fit's own trim stops), plus 20 %. Tones that never decay keep
-    the whole record.
-    """
-    nb = 256
-    if x.size < 64 * nb:
-        return x
-    nblk = x.size // nb
-    rms = np.sqrt(np.mean((x[:nblk * nb].reshape(nblk, nb) - np.median(x)) ** 2, axis=1))
-    noise = noise_std(x, fs)
-    if noise <= 0:
-        return x
-    above = np.flatnonzero(rms > 1.5 * noise)
-    if above.size == 0:
-        return x
-    t1 = (above[-1] + 1) * nb
-    a0 = np.sqrt(2) * float(rms.max())
-    per_tau = np.log(max(a0 / (1.6 * noise), np.e ** 0.5))  # time constants from the peak to t1
-    n_end = int(1.2 * t1 * (1 + np.log(1.6 / 0.3) / per_tau)) + 4 * nb
-    if n_end >= 0.8 * x.size:
-        return x
-    flags.append("noise_floor")
-    return x[:n_end]
+def _mode_shares(p, A, nm, t_end):
+    """Each component's share of the fit: the Wald form of its amplitudes from the Fisher matrix A
+    (the rise in the residual sum of squares if it were left out, to first order). Baseline wander
+    (under two cycles in the span) is collinear with the offset and drift, so its Wald share is
+    small however much of the record it carries: it gets inf (never a candidate for removal)."""
+    try:
+        Ainv = np.linalg.inv(A)
+    except np.linalg.LinAlgError:
+        Ainv = np.linalg.pinv(A)
+    share = np.empty(nm)
+    for k in range(nm):
+        g_ = [4 * k + 2, 4 * k + 3]
+        try:
+            share[k] = float(p[g_] @ np.linalg.solve(Ainv[np.ix_(g_, g_)], p[g_]))
+        except np.linalg.LinAlgError:
+            share[k] = 0.0
+    share[np.abs(p[1:4 * nm:4]) * t_end < 4 * np.pi] = np.inf
+    return share
 
 
 def _pack(sig, om, a, b):

@@ -77,6 +77,9 @@ def guarded(reader, path, **kw):
 
 def write(path: str | os.PathLike, obj) -> Path:
     """Write a :class:`Record` to .csv, .h5/.hdf5 or .wav, atomically (never half-written)."""
+    if not isinstance(path, (str, os.PathLike)):
+        hint = " (the order is vm.write(path, record))" if isinstance(obj, (str, os.PathLike)) else ""
+        raise ParameterError(f"path must be a file name, got {type(path).__name__}{hint}")
     p = Path(path)
     ext = p.suffix.lower()
     if not isinstance(obj, Record):

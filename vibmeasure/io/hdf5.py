@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import json
 
+import os
+
 import numpy as np
 
 from ..core.errors import ParameterError
@@ -27,16 +29,22 @@ _MAGIC = b"VIBMEASURE-SEAL-SHA256 "
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
-def _digest(path, start: int = USERBLOCK, fh=None) -> str:
-    """SHA-256 of the bytes from ``start`` on, of the file at path or of an open file."""
+def _digest(path, start: int = USERBLOCK, fh=None, progress=None) -> str:
+    """SHA-256 of the bytes from ``start`` on, of the file at path or of an open file;
+    ``progress(fraction)`` is called as blocks are hashed."""
     import hashlib
     if fh is None:
         with open(path, "rb") as own:
-            return _digest(path, start, own)
+            return _digest(path, start, own, progress)
     h = hashlib.sha256()
+    total = max(os.fstat(fh.fileno()).st_size - start, 1)
+    done = 0
     fh.seek(start)
     for block in iter(lambda: fh.read(1 << 22), b""):
         h.update(block)
+        done += len(block)
+        if progress is not None:
+            progress(min(done / total, 1.0))
     return h.hexdigest()
 
 
@@ -49,16 +57,17 @@ def seal(path) -> None:
         fh.write(block)
 
 
-def check_seal(path, src: str) -> bool:
+def check_seal(path, src: str, progress=None) -> bool:
     """Before HDF5 parses a file: a file vibmeasure sealed must match its checksum, so a damaged
     byte anywhere is a named error here instead of a crash, a hang or a silently changed number
-    inside the HDF5 library. Returns True for a verified file, False for an unsealed one."""
+    inside the HDF5 library. Returns True for a verified file, False for an unsealed one.
+    ``progress(fraction)`` follows the hashing of a large file."""
     with open(path, "rb") as fh:  # one open file: a writer's rename meanwhile cannot mix two versions
         head = fh.read(USERBLOCK + len(_HDF5_SIGNATURE))
-        return _check_head(path, fh, head, src)
+        return _check_head(path, fh, head, src, progress)
 
 
-def _check_head(path, fh, head: bytes, src: str) -> bool:
+def _check_head(path, fh, head: bytes, src: str, progress=None) -> bool:
     copies = [head[:USERBLOCK // 2], head[USERBLOCK // 2: USERBLOCK]]
     ours = [c for c in copies if c.startswith(_MAGIC)]
     looks_ours = ours or any(b"VIBMEASURE" in c or b"SEAL-SHA256" in c for c in copies)
@@ -68,7 +77,7 @@ def _check_head(path, fh, head: bytes, src: str) -> bool:
         raise ParameterError(f"{src} is damaged: its HDF5 signature after the seal is missing (truncated or "
                              "overwritten)")
     stated = {c[len(_MAGIC): len(_MAGIC) + 64] for c in ours}
-    actual = _digest(path, fh=fh).encode()
+    actual = _digest(path, fh=fh, progress=progress).encode()
     if actual not in stated:
         raise ParameterError(f"{src} is damaged: its content does not match the SHA-256 vibmeasure wrote into it "
                              "(a changed or cut byte; or the file was edited after writing)")

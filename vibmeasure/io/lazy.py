@@ -110,11 +110,13 @@ def _check_stored(d, path):
 
 
 def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: float | None = None,
-                quantity: str | None = None, unit: str | None = None) -> LazyRecord:
+                quantity: str | None = None, unit: str | None = None, progress=None) -> LazyRecord:
     """Open an HDF5 record lazily (out-of-core).
 
     A file in vibmeasure's schema needs nothing more; any other HDF5 file needs ``dataset`` (a
     1-D or (n_channels, n_samples) dataset) and ``fs`` unless the dataset has an ``fs`` attribute.
+    A file vibmeasure wrote is verified against its SHA-256 first (one streamed pass over the
+    file, about 1 s per GB); ``progress(fraction)`` follows that pass.
     """
     import json
     from .hdf5 import SCHEMA, _str_list
@@ -125,7 +127,7 @@ def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: floa
         raise ParameterError(f"path={str(path)!r}: vm.open reads HDF5 (.h5, .hdf5); use vm.read for {p.suffix!r}")
     import h5py
     from .hdf5 import check_seal
-    check_seal(p, f"HDF5 file {str(path)!r}")
+    check_seal(p, f"HDF5 file {str(path)!r}", progress)
     try:
         f = h5py.File(p, "r")
     except (OSError, ValueError) as exc:

@@ -110,6 +110,9 @@ def compare(measured, predicted, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.
             level, why = 1, f"fn {dfn * 100:+.2f} % (> {rtol_fn * 50:g} %, {abs(zf):.1f} std)"
         if np.isfinite(dz) and abs(dz) > rtol_zeta and (sz == 0 or abs(zm - zp) > n_sigma * sz) and level < 1:
             level, why = 1, f"zeta {dz * 100:+.1f} % (> {rtol_zeta * 100:g} %)"
+        if not np.isfinite(zm) and np.isfinite(zp) and level < 1:
+            # a missing damping value is not agreement: say that it was not compared
+            level, why = 1, "measured zeta is NaN (not identified, e.g. dry friction): damping not compared"
         worst = max(worst, level)
         if level:
             reasons.append(f"mode at {fp:.4g} Hz: {why}")
@@ -119,6 +122,10 @@ def compare(measured, predicted, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.
                      "implied_stiffness_change_pct": ((fm / fp) ** 2 - 1) * 100,
                      "mac": float(macm[i, j]) if macm is not None else None,
                      "verdict": LEVELS[level], "reason": why})
+    nan_fn = [i for i in range(meas.n_modes) if not np.isfinite(meas.fn[i])]
+    if nan_fn:  # a mode whose frequency was not identified cannot be paired: never "ok"
+        worst = max(worst, 1)
+        reasons.append(f"{len(nan_fn)} measured mode(s) with fn NaN (not identified) were not compared")
     um = tuple(float(meas.fn[i]) for i in range(meas.n_modes) if i not in {p[0] for p in pairs})
     up = tuple(float(pred.fn[j]) for j in range(pred.n_modes) if j not in {p[1] for p in pairs})
     if not rows:
