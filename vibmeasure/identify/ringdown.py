@@ -293,7 +293,7 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     """
     rec = as_record(rec, fs=fs)
     idx = response_channel(rec, channel)
-    check_memory(10 * 8.0 * rec.n_samples, "ringdown", rec.n_samples)  # about ten record-sized arrays
+    check_memory(16 * 8.0 * rec.n_samples, "ringdown", rec.n_samples)  # measured: 15 record-sized arrays at the peak
     x_all = clean_signal(rec, idx, min_samples=16)
     fsr = rec.fs
     band = check_band(band, fsr)

@@ -35,6 +35,42 @@ def _W(win, nfft, d):
     return abs(np.sum(win * np.exp(-2j * np.pi * d * n / nfft)))
 
 
+@lru_cache(maxsize=32)
+def _cosine_sum(key, nperseg):
+    """The coefficients c_m of a periodic cosine-sum window w[n] = sum_m c_m cos(2 pi m n / N)
+    (Hann, Hamming, Blackman, Blackman-Harris, Nuttall, flat top, boxcar), or None for any other
+    window: its DFT is zero beyond the few lines the cosine terms occupy."""
+    win = _window_cached(key, nperseg)
+    spec = np.fft.rfft(win) / win.size
+    m_max = min(11, spec.size)
+    if np.max(np.abs(spec[m_max:]), initial=0.0) > 1e-12 * abs(spec[0]):
+        return None
+    c = spec[:m_max].real * np.r_[1.0, 2.0 * np.ones(m_max - 1)]
+    if np.max(np.abs(spec[:m_max].imag)) > 1e-12 * abs(spec[0]):
+        return None
+    c[np.abs(c) < 1e-14 * abs(c[0])] = 0.0  # rounding of the window's own DFT
+    return tuple(float(v) for v in np.trim_zeros(c, "b"))
+
+
+def _W_cos(c, N, nfft, d):
+    """|W(d)| of a cosine-sum window in closed form: each cosine term is two shifted Dirichlet kernels
+    sum_n exp(-i x n) = exp(-i x (N-1)/2) sin(N x / 2) / sin(x / 2). O(number of terms), exact."""
+    import cmath
+    import math
+    th = 2 * math.pi * d / nfft
+
+    def dirichlet(x):
+        s = math.sin(0.5 * x)
+        core = N if abs(s) < 1e-300 else math.sin(0.5 * N * x) / s
+        return cmath.exp(-0.5j * x * (N - 1)) * core
+
+    total = c[0] * dirichlet(th)
+    for m in range(1, len(c)):
+        ph = 2 * math.pi * m / N
+        total += 0.5 * c[m] * (dirichlet(th - ph) + dirichlet(th + ph))
+    return abs(total)
+
+
 def _linear_magnitude(spec: Spectrum, ch: int) -> np.ndarray:
     v = np.abs(spec.values[ch])
     return np.sqrt(v) if spec.kind in ("psd", "power") else v
@@ -53,12 +89,21 @@ def interpolate_peak(mag: np.ndarray, k: int, *, window=None, nperseg=None, nfft
         if win is not None:
             side = 1 if c >= a else -1
             alpha = (c if side > 0 else a) / b if b > 0 else 0.0
-            w0 = _W(win, nfft, 0.0)
-            f = lambda d: _W(win, nfft, 1.0 - d) / _W(win, nfft, d) - alpha  # noqa: E731
+            key = window if not isinstance(window, list) else tuple(window)
+            try:
+                coef = _cosine_sum(key, int(nperseg))
+            except TypeError:  # an unhashable window (an array): evaluate its transform directly
+                coef = None
+            if coef is not None:  # closed form: O(1) per evaluation, whatever the segment length
+                Wd = lambda d: _W_cos(coef, int(nperseg), nfft, d)  # noqa: E731
+            else:
+                Wd = lambda d: _W(win, nfft, d)  # noqa: E731
+            w0 = Wd(0.0)
+            f = lambda d: Wd(1.0 - d) / Wd(d) - alpha  # noqa: E731
             lo_v, hi_v = f(0.0), f(0.5)
             if lo_v <= 0 <= hi_v:
                 d = brentq(f, 0.0, 0.5, xtol=1e-12) if lo_v < 0 < hi_v else (0.0 if lo_v == 0 else 0.5)
-                return k + side * d, b * w0 / _W(win, nfft, d)
+                return k + side * d, b * w0 / Wd(d)
     # Gaussian interpolation on log magnitude (exact for a Gaussian window)
     la, lb, lc = np.log(np.maximum([a, b, c], 1e-300))
     den = la - 2 * lb + lc
