@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core._threads import single_threaded
 from ..core._validate import as_record, check_band, check_memory, clean_signal, memory_guard, response_channel
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import FLAG_TEXT, ModalEstimate
@@ -262,6 +263,7 @@ def _lm_inner(p, x, w, t, tn, nm, max_iter):
 
 # ---------------------------------------------------------------------------------------------
 @memory_guard
+@single_threaded
 def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | None = None, max_modes: int = 8,
              fs: float | None = None) -> ModalEstimate:
     """Natural frequencies and damping ratios from a free decay, by maximum likelihood.
