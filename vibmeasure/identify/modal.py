@@ -262,6 +262,77 @@ def _kaufman(theta, w, Q, coef):
     return np.column_stack(cols)
 
 
+FALSE_ALARM = 0.01          # chance per fit that noise alone passes the amplitude test for a mode
+MAX_REL_ZETA_STD_FRF = 0.3  # the limit ringdown uses: a damping this uncertain is not a measurement
+
+
+def _covariance(w, theta, coef, r, sw):
+    """Parameter covariance (poles, then each output's linear coefficients, unweighted) and the
+    residual variance, from the Fisher information of the weighted fit."""
+    J = _full_jacobian(w, theta, coef / sw[None, :], sw)
+    dof = max(r.size - J.shape[1], 1)
+    s2 = float(r @ r) / dof
+    JtJ = J.T @ J
+    try:
+        cov = s2 * np.linalg.inv(JtJ)
+    except np.linalg.LinAlgError:
+        cov = s2 * np.linalg.pinv(JtJ)
+    return cov, s2
+
+
+def _unsupported(theta, coef, cov, sw, tau, n_lines, n_out, band, df):
+    """Poles the data does not support, as (index, reason dict).
+
+    A mode is kept when (1) its residues are significant: the Wald statistic of its 2 n_out real
+    residue coefficients exceeds the chi-square level whose false-alarm chance is FALSE_ALARM
+    divided by the lines searched (the pole's place was chosen among them: Bonferroni); and (2)
+    its zeta is known to better than MAX_REL_ZETA_STD_FRF (relative std); (3) no stronger mode lies
+    within two lines of it. Poles outside the band
+    or with zero, negative or over-critical damping are left to the physical screen."""
+    from scipy.stats import chi2
+    m = theta.size // 2
+    P_nl = 2 * m
+    P_lin = coef.shape[0]
+    level = float(chi2.isf(FALSE_ALARM / max(n_lines, 1), 2 * n_out))
+    cu = coef / sw[None, :]
+    out, tested = [], []
+    for k in range(m):
+        sig = theta[2 * k] - (1.0 / tau if tau else 0.0)
+        wd = theta[2 * k + 1]
+        wn = np.hypot(sig, wd)
+        fn, zeta = wn / (2 * np.pi), sig / wn
+        if not (band[0] <= fn <= band[1]) or not 0 < zeta < 0.5:
+            continue
+        idx = [P_nl + P_lin * o + 2 * k + j for o in range(n_out) for j in (0, 1)]
+        c = np.array([cu[2 * k + j, o] for o in range(n_out) for j in (0, 1)])
+        try:
+            wald = float(c @ np.linalg.solve(cov[np.ix_(idx, idx)], c))
+        except np.linalg.LinAlgError:
+            wald = 0.0
+        zeta_std = pole_to_modal(sig, wd, cov[2 * k:2 * k + 2, 2 * k:2 * k + 2])[3]
+        why = None
+        if not wald > level:
+            why = (f"amplitude not significant: Wald {wald:.3g} <= {level:.3g} (chi-square, {2 * n_out} dof, "
+                   f"false-alarm {FALSE_ALARM:g} per fit over {n_lines} lines)")
+        elif not zeta_std <= MAX_REL_ZETA_STD_FRF * zeta:
+            why = f"damping too uncertain: zeta {zeta:.3g} +- {zeta_std:.2g} (relative std above {MAX_REL_ZETA_STD_FRF})"
+        if why:
+            out.append((k, {"fn_hz": float(fn), "zeta": float(zeta), "zeta_std": float(zeta_std),
+                            "wald": wald, "reason": why}))
+        else:
+            tested.append((k, fn, zeta, float(zeta_std), wald))
+    # two poles less than two lines apart cannot be told apart by the measurement: the one with the
+    # weaker residue is a distortion of the other's peak (leakage, a window), not a second mode
+    for k, fk, zk, zsk, wk in tested:
+        rival = [(w2, f2) for k2, f2, _, _, w2 in tested if k2 != k and abs(f2 - fk) < 2 * df and w2 > wk]
+        if rival:
+            w2, f2 = max(rival)
+            out.append((k, {"fn_hz": float(fk), "zeta": float(zk), "zeta_std": zsk, "wald": wk,
+                            "reason": f"unresolved: {abs(f2 - fk):.3g} Hz from the stronger mode at {f2:.6g} Hz, "
+                                      f"under two lines ({2 * df:.3g} Hz)"}))
+    return out
+
+
 DETECT_FRF = 30.0  # a mode found in the residual must lower the weighted residual sum of squares this much
 
 
@@ -350,16 +421,22 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
     sw = 1 / np.maximum(s_o, 1e-300)
     theta, coef, r = _polish(w, H, _lam(theta), sw)
     theta, coef, r, added = _residual_search(w, H, theta, coef, r, sw, n_modes)
-    J = _full_jacobian(w, theta, coef / sw[None, :], sw)  # unweighted coefficients
-    dof = max(r.size - J.shape[1], 1)
-    s2 = float(r @ r) / dof
-    try:
-        cov = s2 * np.linalg.inv(J.T @ J)
-    except np.linalg.LinAlgError:
-        cov = s2 * np.linalg.pinv(J.T @ J)
+    tau = frf.params.get("exp_window_tau_s")
+    rejected: list[dict] = []
+    for _round in range(theta.size // 2 + 1):  # screen, refit without the unsupported poles, again
+        cov, s2 = _covariance(w, theta, coef, r, sw)
+        out = _unsupported(theta, coef, cov, sw, tau, f.size, H.shape[0], band, float(np.median(np.diff(f))))
+        if not out or n_modes is not None:
+            break
+        rejected += [d for _, d in out]
+        if theta.size // 2 - len(out) < 1:
+            raise FitError(f"no mode in band={band!r} that the data supports: "
+                           + "; ".join(f"{d['fn_hz']:.5g} Hz: {d['reason']}" for d in rejected))
+        drop = {k for k, _ in out}
+        lam_keep = np.array([l for k, l in enumerate(_lam(theta)) if k not in drop])
+        theta, coef, r = _polish(w, H, lam_keep, sw)
     lam = _lam(theta)
     m = lam.size
-    tau = frf.params.get("exp_window_tau_s")
     sig = theta[0::2].copy()
     if tau:
         sig = sig - 1.0 / tau  # the exponential window moved every pole left by exactly 1/tau
@@ -396,6 +473,9 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
     if not keep:
         raise FitError(f"no physical mode in band={band!r}: every pole found has zero, negative or very high "
                        f"damping, or lies outside the band ({dropped})")
+    order = np.argsort(fn[keep], kind="stable")  # modes are listed in frequency order
+    keep = [keep[i] for i in order]
+    flags_mode = [flags_mode[i] for i in order]
     keep = np.array(keep)
     shapes = R[:, keep].copy()
     dp = [o for o, name in enumerate(frf.outputs) if name == frf.inputs[ii]]
@@ -416,7 +496,9 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
               "band_hz": list(band), "frac": frac, "noise_std_per_output": list(1 / sw),
               "stabilisation": table, "n_orders": n_orders, "exp_window_tau_s": tau,
               "exp_window_added_zeta": [float(1 / (tau * wn[k])) for k in keep] if tau else None,
-              "dropped_poles": dropped, "outputs": list(frf.outputs), "input": frf.inputs[ii], "form": frf.form}
+              "dropped_poles": dropped, "rejected_modes": rejected,
+              "mode_test": {"false_alarm_rate": FALSE_ALARM, "max_rel_zeta_std": MAX_REL_ZETA_STD_FRF},
+              "outputs": list(frf.outputs), "input": frf.inputs[ii], "form": frf.form}
     est = ModalEstimate(fn=fn[keep], zeta=zeta[keep], fn_std=fn_std[keep], zeta_std=zeta_std[keep],
                         method="fit_modes", mode_flags=tuple(flags_mode), shapes=shapes, extras=extras)
     warn = [fl for fl in est.flags if fl in ("resolution_limited", "low_coherence")]

@@ -176,7 +176,7 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
             block, shape=(n_ch, s1 - s0, nperseg),
             strides=(block.strides[0], block.strides[1] * step, block.strides[1]), writeable=False)
         m = s1 - s0
-        if pool is None or m < 4 * BATCH:
+        if pool is None or m < 2 * BATCH:
             parts = [work(segs, 0, m, s0)]
         else:
             cut = (m // 2 // BATCH) * BATCH
