@@ -551,3 +551,19 @@ def test_vm_open_reports_progress_while_it_verifies_the_checksum(tmp_path):
     lazy = vm.open(p, progress=seen.append)
     assert lazy.n_samples == 3_000_000
     assert len(seen) >= 5 and seen == sorted(seen) and seen[-1] == 1.0  # 24 MB hashed in 4 MiB blocks
+
+
+def test_psd_in_single_precision_when_asked():
+    x = np.random.default_rng(4).normal(size=2 ** 16).astype(np.float32)
+    rec = vm.Record.from_array(x, fs=1000.0)
+    a, b = vm.psd(rec), vm.psd(rec, dtype="float32")
+    np.testing.assert_allclose(b.values, a.values, rtol=1e-5)  # float32 rounding, 24-bit mantissa
+    with pytest.raises(vm.ParameterError, match="dtype='int8' must be 'float32' or 'float64'"):
+        vm.psd(rec, dtype="int8")
+
+
+def test_ringdown_reports_its_progress_in_stages():
+    rec = vm.synth.free_decay(fn=10.0, zeta=0.01, fs=1000.0, duration=10.0, snr_db=40, seed=1)
+    seen = []
+    vm.ringdown(rec, progress=seen.append)
+    assert seen[0] > 0 and seen[-1] == 1.0 and seen == sorted(seen)

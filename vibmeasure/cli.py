@@ -451,7 +451,7 @@ def _atomic_savefig(fig, path):
             os.unlink(tmp)
 
 
-def _ringdown(args, out):
+def _ringdown(args, out, err=None):
     from . import io
     from .identify import damping, ringdown as rd
     rec = io.read(args.file, fs=args.fs, unit=args.unit, quantity=args.quantity)
@@ -469,7 +469,12 @@ def _ringdown(args, out):
             raise VibMeasureError(f"--modes={args.modes!r} must be 'auto' or a whole number") from None
     band = tuple(args.band) if args.band else None
     if args.method == "ml":
-        est = rd.ringdown(rec, channel=args.channel, n_modes=modes, band=band)
+        bar = _Progress(err, "ringdown", after_s=2.0) if err is not None else None
+        try:
+            est = rd.ringdown(rec, channel=args.channel, n_modes=modes, band=band, progress=bar)
+        finally:
+            if bar is not None:
+                bar.close()
     elif args.method == "logdec":
         est = damping.log_decrement(rec, channel=args.channel, band=band)
     elif args.method == "hilbert":
@@ -542,7 +547,7 @@ def _dispatch(args, out, err) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", QualityWarning)
         try:
-            rec, est = _ringdown(args, out)
+            rec, est = _ringdown(args, out, err)
         except (VibMeasureError, OSError) as exc:
             print(f"vibmeasure: error: {exc}", file=err)
             return 2

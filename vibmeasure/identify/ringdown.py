@@ -265,7 +265,7 @@ def _lm_inner(p, x, w, t, tn, nm, max_iter):
 @memory_guard
 @single_threaded
 def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | None = None, max_modes: int = 8,
-             fs: float | None = None) -> ModalEstimate:
+             fs: float | None = None, progress=None) -> ModalEstimate:
     """Natural frequencies and damping ratios from a free decay, by maximum likelihood.
 
     Parameters
@@ -281,6 +281,9 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     start : float, optional
         Time (s, from the record's start) where the free decay begins; default: found from the
         force pulse or the trigger, else the first sample.
+
+    progress : callable, optional
+        ``progress(fraction)`` after each stage (checks, start values, each maximum-likelihood round).
 
     Returns
     -------
@@ -310,6 +313,7 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         raise ParameterError(f"max_modes={max_modes!r} must be an integer >= 1")
     flags: list[str] = []
     notes: list[str] = []
+    tick = progress if callable(progress) else (lambda fraction: None)
 
     if start is not None:
         from ..core._validate import positive
@@ -349,6 +353,7 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         notes.append("damping changes with amplitude: one mode fitted in "
                      f"{band[0]:.4g}-{band[1]:.4g} Hz; zeta is an average over the decay")
 
+    tick(0.15)
     # --- start values and model order -----------------------------------------------------
     # start values from the unclipped tail when the record is clipped at its start
     c0 = int(np.flatnonzero(clip)[-1]) + 1 if clip.any() else 0
@@ -411,6 +416,7 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     tn = t / T - 0.5
 
     # --- maximum likelihood -----------------------------------------------------------------
+    tick(0.3)
     p = _pack(sig0, om0, a, b)
     q = x.size // SUBSAMPLE
     if q > 1:
@@ -430,6 +436,7 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         if q > 1:  # converge on every q-th sample first: the full record then needs a step or two
             p, _, _ = _lm(p, x[::q], w[::q], t[::q], tn[::q], nm)
         p, rss, A = _lm(p, x, w, t, tn, nm)
+        tick(0.3 + 0.6 * (_round + 1) / (max_modes + 2))
         dof = max(w.sum() - p.size, 1.0)
         s2 = max(rss / dof, (NUM_FLOOR * float(np.max(np.abs(x)))) ** 2 * 1e-6)
         share = _mode_shares(p, A, nm, t[-1])
@@ -566,6 +573,7 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
                         flags=tuple(flags), mode_flags=tuple(tuple(m) for m in mode_flags), amplitude=amp[ik],
                         phase=phase[ik], unit=rec.channels[idx].unit, extras=extras)
     _warn_flags(est, rejected)
+    tick(1.0)
     return est
 
 
