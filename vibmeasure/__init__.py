@@ -72,6 +72,11 @@ _LAZY = {
     "octave_bands": (".signal.spectral", "octave_bands"),
     "psd": (".signal.spectral", "psd"),
     "spectrogram": (".signal.spectral", "spectrogram"),
+    "Store": (".io.store", "Store"),
+    "StoreLockedError": (".io.store", "StoreLockedError"),
+    "batch": (".monitor.batch", "batch"),
+    "read_manifest": (".monitor.batch", "read_manifest"),
+    "trend": (".monitor.trend", "trend"),
     "models": (".", "models"),
     "synth": (".", "synth"),
 }
@@ -101,5 +106,6 @@ __all__ = [
     "detrend", "filter", "decimate", "resample", "integrate", "differentiate",
     "ringdown", "ringdown_crb", "estimate_frf", "impact_frf", "find_hits", "fit_modes", "circle_fit", "mac",
     "modal_crb", "synthesize_frf", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
-    "compare", "Comparison", "History", "diagnose", "Diagnosis", "severity_zone", "Bearing", "Gear", "BEARINGS", "models", "synth", "units", "__version__",
+    "compare", "Comparison", "History", "diagnose", "Diagnosis", "severity_zone", "Bearing", "Gear", "BEARINGS",
+    "Store", "StoreLockedError", "batch", "read_manifest", "trend", "models", "synth", "units", "__version__",
 ]

@@ -130,7 +130,92 @@ def _parser() -> argparse.ArgumentParser:
                     help="pre-whitening before envelope analysis (default cepstral)")
     dg.add_argument("--json", action="store_true", help="print one JSON document")
     dg.add_argument("--plot", metavar="OUT.png", help="spectra with the fault lines and a severity gauge")
+
+    bt = sub.add_parser("batch", help="analyse many records into a measurement store (serially or on Dask)",
+                        description="Analyse files, folders and globs (and/or a manifest CSV) into a vm.Store; "
+                                    "inputs already in the store are skipped.")
+    bt.add_argument("inputs", nargs="*", help="files, folders or globs")
+    bt.add_argument("--store", required=True, help="the store (.h5), created when missing")
+    bt.add_argument("--manifest", help="CSV: file, asset, point, channel, rpm, bearing, model, time")
+    bt.add_argument("--task", default="diagnose",
+                    help="ringdown, modes, spectrum, diagnose, compare, or several joined by + (default diagnose)")
+    bt.add_argument("--workers", type=int, help="local Dask cluster with this many worker processes")
+    bt.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="an existing Dask cluster's scheduler")
+    bt.add_argument("--force", action="store_true", help="analyse inputs already in the store again")
+    bt.add_argument("--keep-raw", action="store_true", help="store the raw records too")
+    bt.add_argument("--fs", type=float, help="sampling rate for files without timing")
+    bt.add_argument("--json", action="store_true", help="print one JSON document")
+
+    tr = sub.add_parser("trend", help="trends, limits and verdicts per asset and point of a store",
+                        description="Baseline, watch/alarm limits, trend slope and verdict per metric.")
+    tr.add_argument("store", help="the store (.h5)")
+    tr.add_argument("--asset")
+    tr.add_argument("--point")
+    tr.add_argument("--baseline", type=int, default=8, help="measurements in the baseline (default 8)")
+    tr.add_argument("--json", action="store_true", help="print one JSON document")
+    tr.add_argument("--plot", metavar="OUT.png", help="trend of the worst metric (needs --asset and --point, or "
+                                                      "takes the worst)")
     return p
+
+
+def _main_batch(args, out, err) -> int:
+    from .monitor.batch import batch
+    from tqdm import tqdm
+    bar = None
+
+    def progress(done, total):
+        nonlocal bar
+        if bar is None:
+            bar = tqdm(total=total, unit="file", file=err, disable=None, leave=False)
+        bar.update(done - bar.n)
+    try:
+        rep = batch(args.inputs, task=args.task, store=args.store, manifest=args.manifest, workers=args.workers,
+                    scheduler=args.scheduler, force=args.force, keep_raw=args.keep_raw, fs=args.fs,
+                    progress=progress)
+    finally:
+        if bar is not None:
+            bar.close()
+    counts = rep["status"].value_counts().to_dict()
+    errors = rep[rep["status"] == "error"]
+    if args.json:
+        json.dump({"command": "batch", "store": args.store, "task": args.task, "counts": counts,
+                   "errors": errors[["file", "message"]].to_dict(orient="records")}, out, indent=2)
+        out.write("\n")
+    else:
+        print(f"{args.store}: {counts.get('done', 0)} analysed, {counts.get('skipped', 0)} skipped (already stored), "
+              f"{counts.get('error', 0)} with errors", file=out)
+        for _, r in errors.iterrows():
+            print(f"  {r['file']}: {r['message']}", file=out)
+    return 0
+
+
+def _main_trend(args, out, err) -> int:
+    from .monitor.trend import trend
+    tr = trend(args.store, asset=args.asset, point=args.point, baseline_count=args.baseline)
+    if args.json:
+        rows = json.loads(tr.to_json(orient="records", date_format="iso"))
+        json.dump({"command": "trend", "store": args.store, "assets": tr.attrs.get("assets", {}),
+                   "points": tr.attrs.get("points", {}), "metrics": rows}, out, indent=2)
+        out.write("\n")
+    else:
+        if tr.empty:
+            print(f"{args.store}: no metric has more than {args.baseline} measurements yet", file=out)
+        for a, v in tr.attrs.get("assets", {}).items():
+            print(f"{a}: {v.upper()}", file=out)
+            for _, r in tr[tr["asset"] == a].iterrows():
+                print(f"  {r['point']:<10} {r['metric']:<20} {r['verdict']:<6} {r['reason']}", file=out)
+    if args.plot:
+        if tr.empty:
+            raise VibMeasureError("nothing to plot: no trended metric")
+        import matplotlib
+        matplotlib.use("Agg")
+        from .plot import plot_trend
+        r = tr.iloc[0]
+        ax = plot_trend(args.store, asset=r["asset"], point=r["point"], metric=r["metric"], task=r["task"],
+                        baseline_count=args.baseline)
+        _save_figure(ax.figure, args.plot)
+        print(f"vibmeasure: wrote {args.plot}", file=err)
+    return 0
 
 
 def _main_diagnose(args, out, err) -> int:
@@ -544,6 +629,10 @@ def _dispatch(args, out, err) -> int:
         return _main_diagnose(args, out, err)
     if args.command == "compare":
         return _main_compare(args, out, err)
+    if args.command == "batch":
+        return _main_batch(args, out, err)
+    if args.command == "trend":
+        return _main_trend(args, out, err)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", QualityWarning)
         try:

@@ -315,3 +315,39 @@ def _plot_kurtogram(ax, kg, band):
     lo, hi, lev, val = kg.best("kurtosis")
     ax.set_title(f"fast kurtogram (cepstral-whitened): max kurtosis {val:.2f} in {lo:.0f}-{hi:.0f} Hz "
                  f"(level {lev:g}); outlined: band of the evidence", fontsize=8)
+
+
+def plot_trend(store, *, asset: str, point: str, metric: str, task: str | None = None, baseline_count: int = 8,
+               ax=None):
+    """One metric of one point over time: the measurements, the baseline band (mean +- std of the
+    first ``baseline_count``), the watch and alarm limits of :func:`vibmeasure.trend` and the verdict."""
+    import matplotlib.pyplot as plt
+    from .io.store import Store
+    from .monitor.trend import METRICS, trend
+    st = store if isinstance(store, Store) else Store(store)
+    tasks = [t for t, c, *_ in METRICS if c == metric and (task is None or t == task)]
+    if not tasks:
+        raise ParameterError(f"metric={metric!r} is not trended; one of {sorted({c for _, c, *_ in METRICS})}")
+    df = next((d for d in (st.results(t, asset=asset, point=point) for t in tasks) if not d.empty and metric in d),
+              None)
+    if df is None:
+        raise ParameterError(f"no {metric} results for {asset}/{point} in the store")
+    tr = trend(st, asset=asset, point=point, baseline_count=baseline_count)
+    row = tr[tr["metric"] == metric]
+    if ax is None:
+        _, ax = plt.subplots(figsize=(8, 3.5))
+    ax.plot(df["time"], df[metric].astype(float), "o-", ms=3, lw=1, color="C0", label=metric)
+    if not row.empty:
+        r = row.iloc[0]
+        mu, sd = r["baseline_mean"], r["baseline_std"]
+        t_b = df["time"].iloc[:baseline_count]
+        ax.axhspan(mu - sd, mu + sd, color="0.85", zorder=0, label=f"baseline (first {baseline_count})")
+        ax.axvspan(t_b.iloc[0], t_b.iloc[-1], color="0.93", zorder=0)
+        ax.axhline(r["watch_limit"], color="orange", ls="--", lw=1, label="watch")
+        ax.axhline(r["alarm_limit"], color="red", ls="--", lw=1, label="alarm")
+        ax.set_title(f"{asset}/{point}: {metric} - {r['verdict']}", fontsize=10)
+    ax.set_xlabel("time")
+    ax.set_ylabel(metric)
+    ax.legend(fontsize=8, loc="best")
+    ax.figure.autofmt_xdate()
+    return ax

@@ -1,0 +1,408 @@
+"""The measurement store: one HDF5 file per condition-monitoring project (schema in docs/store.md).
+
+Assets (machines, structures) with their metadata, measurement points, measurements (time, rpm,
+content hash, the raw record optionally) and results (ring-down and modal estimates, spectra
+summaries, diagnoses, comparisons), each result with the vibmeasure version and the parameters that
+produced it. Rows are JSON documents in variable-length string datasets, so the schema can grow
+without a migration; raw records are datasets of their own.
+
+Crash safety is copy-on-commit: a commit copies the committed file, appends the pending rows to the
+copy, seals it (SHA-256 in the user block), flushes it to disk and renames it over the store. A
+writer killed at any moment leaves the previous committed file (plus a temporary file that the next
+writer removes); readers only ever open a committed file. One writer at a time holds an advisory
+lock (``fcntl.flock`` on ``<store>.lock``, released by the kernel if the holder dies); a second
+writer gets :class:`StoreLockedError` naming the holder, or waits up to ``timeout`` seconds.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import socket
+import time as _time
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import ParameterError, VibMeasureError
+
+__all__ = ["Store", "StoreLockedError", "STORE_SCHEMA", "STORE_VERSION"]
+
+STORE_SCHEMA = "vibmeasure.store"
+STORE_VERSION = 1
+TABLES = ("assets", "points", "measurements", "results")
+
+
+class StoreLockedError(VibMeasureError):
+    """Another process holds the store's writer lock."""
+
+
+def _seconds(t) -> float:
+    """Unix seconds from seconds, an ISO 8601 string, a datetime or a pandas Timestamp (naive = UTC)."""
+    import datetime as _dt
+    if isinstance(t, str):
+        import pandas as pd
+        try:
+            ts = pd.Timestamp(t)
+        except (ValueError, TypeError):
+            raise ParameterError(f"time={t!r} is not an ISO 8601 time") from None
+        t = ts.to_pydatetime()
+    if isinstance(t, _dt.datetime):
+        if t.tzinfo is None:
+            t = t.replace(tzinfo=_dt.timezone.utc)
+        return t.timestamp()
+    if hasattr(t, "timestamp") and callable(t.timestamp):
+        return float(t.timestamp())
+    try:
+        v = float(t)
+    except (TypeError, ValueError):
+        raise ParameterError(f"time={t!r} must be seconds, an ISO 8601 string or a datetime") from None
+    if not np.isfinite(v):
+        raise ParameterError(f"time={t!r} must be finite")
+    return v
+
+
+def _check_name(value, what: str) -> str:
+    if not isinstance(value, str) or not value.strip() or len(value) > 200 or any(c in value for c in "\n\r\0"):
+        raise ParameterError(f"{what}={value!r} must be a non-empty name (one line, at most 200 characters)")
+    return value
+
+
+class Store:
+    """A condition-monitoring store: ``Store(path)`` reads; ``Store(path, writable=True)`` also
+    writes (creating the file) under the writer lock. Use as a context manager: the pending rows are
+    committed on a clean exit and the lock is released.
+
+    >>> with vm.Store("plant.h5", writable=True) as st:
+    ...     st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+    ...     st.add_point("pump-1", "DE-H", channel="acc", direction="horizontal", unit="g")
+    ...     mid = st.add_measurement("pump-1", "DE-H", time="2026-11-22T08:00", rpm=1480)
+    ...     st.add_result(mid, "diagnose", diag.to_dict(), summary={"top": diag.top})
+    >>> vm.Store("plant.h5").results("diagnose", asset="pump-1")          # a DataFrame
+    """
+
+    def __init__(self, path, *, writable: bool = False, timeout: float = 0.0):
+        self.path = Path(path)
+        self.writable = bool(writable)
+        self._lock_fd = None
+        self._pending: dict[str, list] = {k: [] for k in TABLES}
+        self._raw_pending: dict[str, object] = {}
+        if self.writable:
+            self._lock(timeout)
+        try:
+            self._rows = self._load() if self.path.exists() else {k: [] for k in TABLES}
+        except BaseException:
+            self._unlock()
+            raise
+        if not self.path.exists() and not self.writable:
+            raise ParameterError(f"store {str(self.path)!r} does not exist (open it with writable=True to create it)")
+        self._index()
+
+    # --- locking -------------------------------------------------------------------------------
+    def _lock(self, timeout):
+        import fcntl
+        lock_path = self.path.with_name(self.path.name + ".lock")
+        try:
+            fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as exc:
+            raise ParameterError(f"store {str(self.path)!r}: cannot create its lock file ({exc.strerror})") from None
+        deadline = _time.monotonic() + max(float(timeout), 0.0)
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if _time.monotonic() >= deadline:
+                    try:
+                        holder = os.pread(fd, 200, 0).decode(errors="replace").strip() or "another process"
+                    finally:
+                        os.close(fd)
+                    raise StoreLockedError(f"store {str(self.path)!r} is being written by {holder}; one writer at a "
+                                           "time (wait with timeout=, or read it with writable=False)") from None
+                _time.sleep(0.05)
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"pid {os.getpid()} on {socket.gethostname()} since "
+                      f"{_time.strftime('%Y-%m-%dT%H:%M:%S')}".encode(), 0)
+        self._lock_fd = fd
+
+    def _unlock(self):
+        if self._lock_fd is not None:
+            import fcntl
+            try:
+                os.ftruncate(self._lock_fd, 0)
+                fcntl.flock(self._lock_fd, fcntl.LOCK_UN)
+            finally:
+                os.close(self._lock_fd)
+                self._lock_fd = None
+
+    def close(self, *, commit: bool = True):
+        """Commit the pending rows (unless ``commit=False``) and release the writer lock."""
+        try:
+            if commit and self.writable:
+                self.commit()
+        finally:
+            self._unlock()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        self.close(commit=exc_type is None)
+
+    def __del__(self):
+        try:
+            self._unlock()
+        except Exception:
+            pass
+
+    # --- reading ------------------------------------------------------------------------------
+    def _load(self) -> dict:
+        import h5py
+        from .hdf5 import check_seal
+        src = f"store {str(self.path)!r}"
+        if not self.path.is_file():
+            raise ParameterError(f"{src} is not a file")
+        if not check_seal(self.path, src):
+            raise ParameterError(f"{src} is not a vibmeasure store (no seal: not written by vm.Store)")
+        try:
+            with h5py.File(self.path, "r") as f:
+                schema = f.attrs.get("vibmeasure_schema")
+                schema = schema.decode() if isinstance(schema, bytes) else schema
+                if schema != STORE_SCHEMA:
+                    raise ParameterError(f"{src} is not a vibmeasure store (schema {schema!r})")
+                version = int(f.attrs.get("schema_version", -1))
+                if version != STORE_VERSION:
+                    raise ParameterError(f"{src} has store schema version {version}; this vibmeasure reads version "
+                                         f"{STORE_VERSION} (upgrade vibmeasure, or convert the store)")
+                rows = {}
+                for k in TABLES:
+                    d = f[k]
+                    rows[k] = [json.loads(v) for v in d.asstr()[()]] if d.shape[0] else []
+        except (OSError, KeyError, ValueError, TypeError) as exc:
+            if isinstance(exc, ParameterError):
+                raise
+            raise ParameterError(f"{src} is damaged: {exc}") from None
+        return rows
+
+    def _index(self):
+        allrows = {k: self._rows[k] + self._pending[k] for k in TABLES}
+        self._assets = {r["asset"]: r for r in allrows["assets"]}
+        self._points = {(r["asset"], r["point"]): r for r in allrows["points"]}
+        self._meas = {r["id"]: r for r in allrows["measurements"]}
+        self._hashes = {r["sha256"]: r["id"] for r in allrows["measurements"] if r.get("sha256")}
+
+    def _frame(self, table, **filters):
+        import pandas as pd
+        rows = self._rows[table] + self._pending[table]
+        df = pd.DataFrame(rows)
+        for k, v in filters.items():
+            if v is not None and k in df:
+                df = df[df[k] == v]
+        return df.reset_index(drop=True)
+
+    def assets(self):
+        """Assets as a DataFrame (asset, kind, bearing, gear, model, iso_group, foundation, meta)."""
+        return self._frame("assets")
+
+    def points(self, asset: str | None = None):
+        """Measurement points as a DataFrame (asset, point, channel, direction, unit)."""
+        return self._frame("points", asset=asset)
+
+    def measurements(self, asset: str | None = None, point: str | None = None, since=None, until=None):
+        """Measurements as a DataFrame, oldest first; ``time`` as UTC Timestamps."""
+        return self._timed(self._frame("measurements", asset=asset, point=point), since, until)
+
+    def results(self, task: str, asset: str | None = None, point: str | None = None, since=None, until=None):
+        """Results of one task as a DataFrame, oldest first: measurement, asset, point, time, task,
+        version, params, the summary values as columns and ``result`` (the full result, a dict)."""
+        import pandas as pd
+        rows = [r for r in self._rows["results"] + self._pending["results"] if r["task"] == task]
+        flat = []
+        for r in rows:
+            m = self._meas.get(r["measurement"], {})
+            flat.append({"measurement": r["measurement"], "asset": m.get("asset"), "point": m.get("point"),
+                         "time": m.get("time"), "task": r["task"], "version": r["version"],
+                         "params": r.get("params", {}), **r.get("summary", {}), "result": r.get("result")})
+        df = pd.DataFrame(flat)
+        if df.empty:
+            return pd.DataFrame(columns=["measurement", "asset", "point", "time", "task", "version", "params"])
+        for k, v in (("asset", asset), ("point", point)):
+            if v is not None:
+                df = df[df[k] == v]
+        return self._timed(df.reset_index(drop=True), since, until)
+
+    def errors(self):
+        """Inputs a batch could not analyse: measurement, file and the error message."""
+        return self.results("error")
+
+    @staticmethod
+    def _timed(df, since, until):
+        import pandas as pd
+        if df.empty or "time" not in df:
+            return df
+        if since is not None:
+            df = df[df["time"] >= _seconds(since)]
+        if until is not None:
+            df = df[df["time"] <= _seconds(until)]
+        df = df.sort_values("time", kind="stable").reset_index(drop=True)
+        df["time"] = pd.to_datetime(df["time"], unit="s", utc=True)
+        return df
+
+    def has(self, sha256: str) -> str | None:
+        """The measurement id already stored for this content hash, or None."""
+        return self._hashes.get(sha256)
+
+    def record(self, measurement: str):
+        """The raw record stored with a measurement (``keep_raw=True``)."""
+        import h5py
+        from ..core.record import Channel, Record
+        if measurement in self._raw_pending:
+            return self._raw_pending[measurement]
+        if measurement not in self._meas:
+            raise ParameterError(f"measurement={measurement!r} is not in store {str(self.path)!r}")
+        with h5py.File(self.path, "r") as f:
+            if f"raw/{measurement}" not in f:
+                raise ParameterError(f"measurement {measurement!r} was stored without its raw record")
+            d = f[f"raw/{measurement}"]
+            chans = json.loads(d.attrs["channels"])
+            return Record(d[()], float(d.attrs["fs"]), [Channel(**c) for c in chans], t0=float(d.attrs["t0"]))
+
+    # --- writing ------------------------------------------------------------------------------
+    def _need_writable(self):
+        if not self.writable or self._lock_fd is None:
+            raise ParameterError(f"store {str(self.path)!r} is open for reading: open it with writable=True to add")
+
+    def add_asset(self, asset: str, *, kind: str = "machine", bearing=None, gear=None, model=None,
+                  iso_group: int | None = None, foundation: str | None = None, meta: dict | None = None) -> str:
+        """An asset (a machine or a structure) with what its analysis needs: a bearing (catalogue name
+        or ``N,d,D,angle``), gear teeth, a model (TOML path), the ISO 10816-3 group and foundation.
+        Adding an asset that exists with the same description does nothing; a different one is an error."""
+        self._need_writable()
+        _check_name(asset, "asset")
+        if iso_group is not None and iso_group not in (1, 2):
+            raise ParameterError(f"iso_group={iso_group!r} must be 1 or 2 (ISO 10816-3)")
+        row = {"asset": asset, "kind": str(kind), "bearing": None if bearing is None else str(bearing),
+               "gear": gear, "model": None if model is None else str(model), "iso_group": iso_group,
+               "foundation": foundation, "meta": meta or {}}
+        json.dumps(row)  # must be JSON
+        old = self._assets.get(asset)
+        if old is not None:
+            if old != row:
+                raise ParameterError(f"asset={asset!r} exists in the store with a different description")
+            return asset
+        self._pending["assets"].append(row)
+        self._assets[asset] = row
+        return asset
+
+    def add_point(self, asset: str, point: str, *, channel: str | None = None, direction: str | None = None,
+                  unit: str | None = None) -> str:
+        """A measurement point of an asset: the channel it is recorded on, direction, sensor unit."""
+        self._need_writable()
+        _check_name(point, "point")
+        if asset not in self._assets:
+            raise ParameterError(f"asset={asset!r} is not in the store: add_asset first")
+        row = {"asset": asset, "point": point, "channel": channel, "direction": direction, "unit": unit}
+        old = self._points.get((asset, point))
+        if old is not None:
+            if old != row:
+                raise ParameterError(f"point {asset}/{point} exists in the store with a different description")
+            return point
+        self._pending["points"].append(row)
+        self._points[(asset, point)] = row
+        return point
+
+    def add_measurement(self, asset: str, point: str, *, time, rpm: float | None = None, record=None,
+                        keep_raw: bool = False, sha256: str | None = None, file: str | None = None,
+                        meta: dict | None = None) -> str:
+        """A measurement of a point at ``time`` (Unix seconds, ISO 8601 or datetime); returns its id.
+        ``record`` with ``keep_raw=True`` stores the raw samples; ``sha256`` (default: of the record's
+        samples) lets a batch skip inputs it has analysed before."""
+        self._need_writable()
+        if (asset, point) not in self._points:
+            raise ParameterError(f"point {asset}/{point} is not in the store: add_point first")
+        t = _seconds(time)
+        if rpm is not None and not (np.isfinite(rpm) and rpm > 0):
+            raise ParameterError(f"rpm={rpm!r} must be > 0")
+        if sha256 is None and record is not None:
+            import hashlib
+            sha256 = hashlib.sha256(np.ascontiguousarray(record.data).tobytes()).hexdigest()
+        mid = f"m{len(self._meas) + 1:07d}"
+        row = {"id": mid, "asset": asset, "point": point, "time": t, "rpm": None if rpm is None else float(rpm),
+               "sha256": sha256, "file": file, "raw": bool(keep_raw and record is not None), "meta": meta or {}}
+        self._pending["measurements"].append(row)
+        self._meas[mid] = row
+        if sha256:
+            self._hashes[sha256] = mid
+        if keep_raw and record is not None:
+            self._raw_pending[mid] = record
+        return mid
+
+    def add_result(self, measurement: str, task: str, result: dict, *, params: dict | None = None,
+                   summary: dict | None = None) -> None:
+        """A result of ``task`` for a measurement: the full result (a JSON-able dict, e.g.
+        ``est.to_dict()``), the parameters that produced it and a flat ``summary`` (numbers and short
+        strings) that becomes columns of :meth:`results`. The vibmeasure version is recorded."""
+        self._need_writable()
+        from .. import __version__
+        from ..core.results import _jsonable
+        if measurement not in self._meas:
+            raise ParameterError(f"measurement={measurement!r} is not in the store")
+        row = _jsonable({"measurement": measurement, "task": _check_name(task, "task"), "version": __version__,
+                         "params": params or {}, "summary": summary or {}, "result": result})
+        json.dumps(row, allow_nan=True)
+        self._pending["results"].append(row)
+
+    @property
+    def pending(self) -> int:
+        """Rows added since the last commit."""
+        return sum(len(v) for v in self._pending.values())
+
+    def commit(self) -> None:
+        """Make the pending rows durable: copy, append, seal, fsync, rename (see the module doc)."""
+        self._need_writable()
+        if not self.pending and self.path.exists():
+            return
+        import h5py
+        from .. import __version__
+        from ._common import atomic_path
+        from .hdf5 import USERBLOCK, seal
+        with atomic_path(self.path) as tmp:
+            if self.path.exists():
+                shutil.copyfile(self.path, tmp)
+                f = h5py.File(tmp, "r+")
+            else:
+                f = h5py.File(tmp, "w", userblock_size=USERBLOCK)
+                f.attrs["vibmeasure_schema"] = STORE_SCHEMA
+                f.attrs["schema_version"] = STORE_VERSION
+                f.attrs["created"] = _time.time()
+                str_t = h5py.string_dtype()
+                for k in TABLES:
+                    f.create_dataset(k, shape=(0,), maxshape=(None,), dtype=str_t, chunks=(256,))
+                f.create_group("raw")
+            with f:
+                f.attrs["written_by"] = f"vibmeasure {__version__}"
+                for k in TABLES:
+                    new = self._pending[k]
+                    if not new:
+                        continue
+                    d = f[k]
+                    n0 = d.shape[0]
+                    d.resize((n0 + len(new),))
+                    d[n0:] = [json.dumps(r, allow_nan=True) for r in new]
+                for mid, rec in self._raw_pending.items():
+                    d = f["raw"].create_dataset(mid, data=np.asarray(rec.data), compression="gzip", compression_opts=1)
+                    d.attrs["fs"] = rec.fs
+                    d.attrs["t0"] = rec.t0
+                    d.attrs["channels"] = json.dumps([{"name": c.name, "quantity": c.quantity, "unit": c.unit,
+                                                       "location": c.location} for c in rec.channels])
+            seal(tmp)
+        for k in TABLES:
+            self._rows[k] += self._pending[k]
+            self._pending[k] = []
+        self._raw_pending = {}
+
+    def __repr__(self) -> str:
+        n = {k: len(self._rows[k]) + len(self._pending[k]) for k in TABLES}
+        return (f"Store({str(self.path)!r}: {n['assets']} assets, {n['points']} points, {n['measurements']} "
+                f"measurements, {n['results']} results{'; writable' if self.writable else ''})")

@@ -1,0 +1,368 @@
+"""Batch analysis into a measurement store, serially or on a Dask cluster.
+
+Inputs are files, folders and globs, with an optional manifest (CSV: ``file`` (name or glob relative
+to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``model``, ``time``).
+Each input is read and analysed by a pure function (:func:`analyse_file`) that returns plain data;
+with Dask the workers run it and only the client writes the store, committing every few dozen
+results. One bad file never stops the batch: its error is stored and listed. Inputs whose content
+hash is already in the store are skipped unless ``force=True``.
+"""
+
+from __future__ import annotations
+
+import csv
+import glob
+import hashlib
+import os
+import time as _time
+from pathlib import Path
+
+import numpy as np
+
+from ..core._threads import one_blas_thread
+from ..core.errors import ParameterError, VibMeasureError
+
+__all__ = ["batch", "read_manifest", "analyse_file", "TASKS", "MANIFEST_COLUMNS"]
+
+TASKS = ("ringdown", "modes", "spectrum", "diagnose", "compare")
+MANIFEST_COLUMNS = ("file", "asset", "point", "channel", "rpm", "bearing", "model", "time")
+READABLE = (".csv", ".txt", ".h5", ".hdf5", ".wav", ".mat", ".lvm", ".uff", ".unv")
+COMMIT_EVERY = 50       # results per commit (each commit rewrites the store: see io/store.py)
+COMMIT_SECONDS = 10.0
+SPECTRUM_BANDS = ((2.0, 10.0), (10.0, 1000.0), (1000.0, 10000.0))  # Hz: sub-synchronous, ISO 10816, bearing/gear
+
+
+def _tasks(task) -> tuple[str, ...]:
+    items = [task] if isinstance(task, str) else list(task)
+    out = []
+    for t in items:
+        for part in str(t).replace("+", ",").split(","):
+            part = part.strip()
+            if part not in TASKS:
+                raise ParameterError(f"task={part!r} must be one of {TASKS} (or several joined by '+')")
+            if part not in out:
+                out.append(part)
+    if not out:
+        raise ParameterError(f"task must name at least one of {TASKS}")
+    return tuple(out)
+
+
+def read_manifest(path) -> list[dict]:
+    """Rows of a manifest CSV, each with its ``file`` glob expanded (relative to the manifest)."""
+    p = Path(path)
+    if not p.is_file():
+        raise ParameterError(f"manifest={str(path)!r} does not exist")
+    with open(p, newline="", encoding="utf-8-sig") as fh:
+        reader = csv.DictReader(fh)
+        cols = [c.strip() for c in (reader.fieldnames or [])]
+        unknown = [c for c in cols if c not in MANIFEST_COLUMNS]
+        if unknown:
+            raise ParameterError(f"manifest {str(path)!r}: unknown column(s) {unknown}; the columns are "
+                                 f"{list(MANIFEST_COLUMNS)}")
+        if "file" not in cols:
+            raise ParameterError(f"manifest {str(path)!r} needs a 'file' column")
+        rows = []
+        for i, raw in enumerate(reader, start=2):
+            row = {k.strip(): (v.strip() if isinstance(v, str) else v) for k, v in raw.items() if k}
+            if not row.get("file"):
+                raise ParameterError(f"manifest {str(path)!r} line {i}: empty 'file'")
+            pattern = row["file"] if os.path.isabs(row["file"]) else str(p.parent / row["file"])
+            hits = sorted(glob.glob(pattern)) if any(c in pattern for c in "*?[") else [pattern]
+            if not hits:
+                raise ParameterError(f"manifest {str(path)!r} line {i}: no file matches {row['file']!r}")
+            if row.get("rpm"):
+                try:
+                    row["rpm"] = float(row["rpm"])
+                except ValueError:
+                    raise ParameterError(f"manifest {str(path)!r} line {i}: rpm={row['rpm']!r} is not a number") from None
+            if row.get("model") and not os.path.isabs(row["model"]):
+                row["model"] = str(p.parent / row["model"])
+            for h in hits:
+                rows.append({k: (v if v != "" else None) for k, v in dict(row, file=h).items()})
+    return rows
+
+
+def _expand(inputs) -> list[dict]:
+    if isinstance(inputs, (str, os.PathLike)):
+        inputs = [inputs]
+    items = []
+    for x in inputs:
+        s = str(x)
+        if any(c in s for c in "*?["):
+            hits = sorted(glob.glob(s, recursive=True))
+            if not hits:
+                raise ParameterError(f"input {s!r} matches no file")
+        elif os.path.isdir(s):
+            hits = sorted(str(q) for q in Path(s).rglob("*") if q.suffix.lower() in READABLE and q.is_file())
+        elif os.path.isfile(s):
+            hits = [s]
+        else:
+            raise ParameterError(f"input {s!r} is not a file, folder or glob")
+        items += [{"file": h} for h in hits if Path(h).suffix.lower() in READABLE]
+    return items
+
+
+def _file_sha256(path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 22), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+# --- the work of one input (runs on a worker) ------------------------------------------------------
+def _summary_modes(est) -> dict:
+    out = {"n_modes": int(est.n_modes)}
+    for k in range(min(est.n_modes, 4)):
+        out[f"fn{k + 1}_hz"] = float(est.fn[k])
+        out[f"zeta{k + 1}"] = float(est.zeta[k])
+        out[f"fn{k + 1}_std"] = float(est.fn_std[k])
+    return out
+
+
+def _run(task, rec, item, options):
+    import vibmeasure as vm
+    ch = item.get("channel")
+    if task == "ringdown":
+        est = vm.ringdown(rec, channel=ch)
+        return est.to_dict(), _summary_modes(est), {"channel": est.extras.get("channel")}
+    if task == "modes":
+        forces = [c.name for c in rec.channels if c.quantity == "force"]
+        if not forces:
+            raise ParameterError("task 'modes' needs a force channel (quantity 'force') in the record")
+        band = options.get("band") or (max(1.0, 2 * rec.fs / rec.n_samples), 0.4 * rec.fs)
+        frf = vm.estimate_frf(rec, input=forces[0])
+        est = vm.fit_modes(frf, band=tuple(band))
+        return est.to_dict(), _summary_modes(est), {"input": forces[0], "band": list(band)}
+    if task == "spectrum":
+        names = [ch] if ch else None
+        psd = vm.psd(rec, channels=names)
+        amp = vm.amplitude_spectrum(rec, channels=names, nperseg=min(rec.n_samples, 1 << 14))
+        pk = vm.pick_peaks(amp, n=5)
+        summary = {"rms": float(np.sqrt(np.sum(psd.values[0]) * psd.df))}
+        for lo, hi in SPECTRUM_BANDS:
+            if lo < rec.fs / 2:
+                summary[f"rms_{lo:g}_{min(hi, rec.fs / 2):g}_hz"] = float(vm.band_rms(psd, (lo, min(hi, 0.499 * rec.fs)))[0])
+        for k in range(len(pk)):
+            summary[f"peak{k + 1}_hz"] = float(pk.freq[k])
+            summary[f"peak{k + 1}_amp"] = float(pk.amplitude[k])
+        result = {"unit": psd.unit, "df_hz": psd.df, "peaks_hz": list(pk.freq), "peaks_amp": list(pk.amplitude),
+                  "bands": summary}
+        return result, summary, {"nperseg": psd.params["nperseg"], "channel": psd.channels[0]}
+    if task == "diagnose":
+        rpm = item.get("rpm")
+        if rpm is None:
+            raise ParameterError("task 'diagnose' needs the shaft speed: give rpm in the manifest")
+        d = vm.diagnose(rec, rpm=float(rpm), bearing=item.get("bearing"), channel=ch)
+        sev = d.severity or {}
+        summary = {"top": d.top, "confidence": float(d.confidence),
+                   "velocity_rms_mm_s": sev.get("velocity_rms_mm_s"), "zone": sev.get("zone"),
+                   "bearing_checked": bool(d.bearing_checked)}
+        fam = d.faults
+        if fam is not None and "log10_p" in getattr(fam, "columns", ()):
+            # the bearing evidence, -log10 p of the strongest family (0 when nothing was tested)
+            lp = [float(v) for f, v in zip(fam["fault"], fam["log10_p"])
+                  if str(f).startswith("bearing_") and f != "bearing_cage" and v == v and v is not None]
+            summary["bearing_evidence"] = float(-min(lp)) if lp else 0.0
+        return d.to_dict(), summary, {"rpm": float(rpm), "bearing": item.get("bearing"), "channel": d.channel}
+    raise ParameterError(f"task {task!r} is not a per-file task")
+
+
+def analyse_file(item: dict, tasks, options: dict | None = None) -> dict:
+    """Read one input and run the per-file tasks on it (``compare`` is done by the client, which
+    knows the history). Returns plain data: the item, the file's SHA-256, its time, per task
+    (result, summary, params) or an error message. Never raises for a bad file. BLAS runs on one
+    thread: workers share the machine."""
+    import warnings
+    options = options or {}
+    out = {"item": dict(item), "sha256": None, "time": None, "results": {}, "errors": {}, "channels": []}
+    with one_blas_thread(), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            import vibmeasure as vm
+            out["sha256"] = _file_sha256(item["file"])
+            rec = vm.read(item["file"], fs=options.get("fs"))
+            out["channels"] = [c.name for c in rec.channels]
+            out["n_samples"], out["fs"] = int(rec.n_samples), float(rec.fs)
+            t = item.get("time") or rec.meta.get("time") or rec.meta.get("start_time")
+            out["time"] = t if t is not None else os.path.getmtime(item["file"])
+        except (VibMeasureError, OSError, ValueError) as exc:
+            out["errors"]["read"] = f"{type(exc).__name__}: {exc}"
+            return out
+        for task in tasks:
+            if task == "compare":
+                continue
+            try:
+                out["results"][task] = _run(task, rec, item, options)
+            except (VibMeasureError, ValueError, ArithmeticError) as exc:
+                out["errors"][task] = f"{type(exc).__name__}: {exc}"
+            except Exception as exc:  # a defect of vibmeasure: stored, named, the batch goes on
+                out["errors"][task] = f"unexpected {type(exc).__name__}: {exc} (a defect of vibmeasure)"
+    return out
+
+
+# --- the client -----------------------------------------------------------------------------------
+def _register(store, item, channels):
+    asset = item.get("asset") or Path(item["file"]).parent.name or "default"
+    point = item.get("point") or item.get("channel") or (channels[0] if channels else "point")
+    if asset not in store._assets:
+        store.add_asset(asset, bearing=item.get("bearing"), model=item.get("model"))
+    if (asset, point) not in store._points:
+        store.add_point(asset, point, channel=item.get("channel"))
+    return asset, point
+
+
+def _estimate(d: dict, method: str):
+    """A ModalEstimate (fn, zeta and their std) back from its stored ``to_dict()`` form."""
+    from ..core.results import ModalEstimate
+    modes = d.get("modes", [])
+    if not modes:
+        raise ParameterError("the stored estimate has no mode to compare")
+    col = lambda k: [np.nan if m.get(k) is None else m[k] for m in modes]  # noqa: E731
+    return ModalEstimate(fn=col("fn_hz"), zeta=col("zeta"), fn_std=col("fn_std_hz"), zeta_std=col("zeta_std"),
+                         method=method)
+
+
+def _compare(store, asset, point, mid, results):
+    """Compare this measurement's modal estimate with the asset's model (TOML) or, failing that, the
+    point's first stored estimate (the baseline)."""
+    import vibmeasure as vm
+    src = results.get("ringdown") or results.get("modes")
+    if src is None:
+        raise ParameterError("task 'compare' needs 'ringdown' or 'modes' in the same batch")
+    meas = _estimate(src[0], src[0].get("method", "ml"))
+    model = store._assets[asset].get("model")
+    if model:
+        pred, against = vm.models.load(model), f"model {model}"
+    else:
+        prev = store.results("ringdown" if "ringdown" in results else "modes", asset=asset, point=point)
+        prev = prev[prev["measurement"] != mid]
+        if prev.empty:
+            return None
+        pred = _estimate(prev.iloc[0]["result"], "baseline")
+        against = f"baseline {prev.iloc[0]['measurement']}"
+    c = vm.compare(meas, pred)
+    dev = [abs(r["fn_dev_pct"]) for r in c.rows]
+    return c.to_dict(), {"verdict": c.verdict, "max_fn_dev_pct": max(dev) if dev else None}, {"against": against}
+
+
+def _store_one(store, out, tasks, keep_raw, options):
+    item = out["item"]
+    asset, point = _register(store, item, out.get("channels", []))
+    rec = None
+    if keep_raw and not out["errors"].get("read"):
+        import vibmeasure as vm
+        rec = vm.read(item["file"], fs=options.get("fs"))
+    mid = store.add_measurement(asset, point, time=out["time"] if out["time"] is not None else _time.time(),
+                                rpm=item.get("rpm"), sha256=out["sha256"], file=str(item["file"]), record=rec,
+                                keep_raw=keep_raw)
+    for task, (result, summary, params) in out["results"].items():
+        store.add_result(mid, task, result, params=params, summary=summary)
+    if "compare" in tasks and not out["errors"].get("read"):
+        try:
+            c = _compare(store, asset, point, mid, out["results"])
+            if c is not None:
+                store.add_result(mid, "compare", c[0], params=c[2], summary=c[1])
+        except (VibMeasureError, ValueError) as exc:
+            out["errors"]["compare"] = f"{type(exc).__name__}: {exc}"
+    for task, msg in out["errors"].items():
+        store.add_result(mid, "error", {"task": task, "message": msg}, summary={"failed_task": task, "message": msg})
+    return mid
+
+
+def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, workers: int | None = None,
+          scheduler: str | None = None, force: bool = False, keep_raw: bool = False, fs: float | None = None,
+          band=None, progress=None):
+    """Analyse many inputs into a :class:`vibmeasure.Store`; returns a DataFrame, one row per input
+    (file, status done / skipped / error, measurement id, message).
+
+    ``task``: "ringdown", "modes", "spectrum", "diagnose", "compare" or several ("spectrum+diagnose").
+    ``store``: a path or a writable Store. ``client``: a ``dask.distributed.Client``; or ``workers=N``
+    starts a local Dask cluster on 127.0.0.1 (N processes, one thread each), or ``scheduler`` is the
+    address of an existing one ("tcp://host:8786"). Without them the batch runs serially. A task that
+    fails on a worker is retried twice (a worker that dies loses no input). ``progress(done, total)``
+    is called as inputs finish.
+    """
+    from ..io.store import Store
+    tasks = _tasks(task)
+    items = _expand(inputs) if inputs else []
+    if manifest is not None:
+        items += read_manifest(manifest)
+    if not items:
+        raise ParameterError("no input: give files, folders or globs, or a manifest")
+    options = {"fs": fs, "band": band}
+    own = not isinstance(store, Store)
+    st = Store(store, writable=True) if own else store
+    rows, todo = [], []
+    try:
+        for it in items:
+            sha = None
+            if not force:
+                try:
+                    sha = _file_sha256(it["file"])
+                except OSError as exc:
+                    rows.append({"file": it["file"], "status": "error", "measurement": None, "message": str(exc)})
+                    continue
+            mid = st.has(sha) if sha else None
+            if mid is not None:
+                rows.append({"file": it["file"], "status": "skipped", "measurement": mid,
+                             "message": "already in the store (same content); force=True to analyse again"})
+            else:
+                todo.append(it)
+        total = len(todo)
+        done = 0
+        last_commit = _time.monotonic()
+
+        def take(out):
+            nonlocal done, last_commit
+            mid = _store_one(st, out, tasks, keep_raw, options)
+            err = "; ".join(f"{k}: {v}" for k, v in out["errors"].items())
+            rows.append({"file": out["item"]["file"], "status": "error" if err else "done", "measurement": mid,
+                         "message": err})
+            done += 1
+            if progress is not None:
+                progress(done, total)
+            if st.pending >= COMMIT_EVERY or _time.monotonic() - last_commit > COMMIT_SECONDS:
+                st.commit()
+                last_commit = _time.monotonic()
+
+        dask_client, cluster = _client(client, workers, scheduler)
+        try:
+            if dask_client is None:
+                for it in todo:
+                    take(analyse_file(it, tasks, options))
+            else:
+                from distributed import as_completed
+                futs = [dask_client.submit(analyse_file, it, tasks, options, retries=2, pure=False) for it in todo]
+                for fut in as_completed(futs):
+                    take(fut.result())
+                    fut.release()
+        finally:
+            if cluster is not None:
+                dask_client.close()
+                cluster.close()
+        st.commit()
+    finally:
+        if own:
+            st.close()
+    import pandas as pd
+    return pd.DataFrame(rows, columns=["file", "status", "measurement", "message"])
+
+
+def _client(client, workers, scheduler):
+    if client is not None:
+        return client, None
+    if workers is None and scheduler is None:
+        return None, None
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise ParameterError("workers= and scheduler= need Dask: pip install 'vibmeasure[dask]'") from None
+    if scheduler is not None:
+        return Client(scheduler), None
+    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
+        raise ParameterError(f"workers={workers!r} must be an integer >= 1")
+    cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, host="127.0.0.1",
+                           dashboard_address=None, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
+                                                        "MKL_NUM_THREADS": "1"})
+    return Client(cluster), cluster

@@ -1,0 +1,128 @@
+"""Trends and alarms over a measurement store: per asset, point and metric a baseline from the first
+healthy measurements, limits from its statistics (and ISO 10816-3 zones for velocity RMS), the trend
+slope with its std and the projected crossing of the alarm limit; a verdict ok / watch / alarm per
+metric, rolled up per point and per asset.
+
+Limits: watch at baseline mean + K_WATCH std, alarm at + K_ALARM std, in the metric's bad direction,
+never closer to the baseline than the metric's floor (a relative change, or an absolute level), so a
+very quiet baseline does not turn measurement noise into alarms. A level counts only when the last
+two measurements both reach it (one outlier is a watch at most). A significant slope (above 2 std)
+that reaches the alarm limit within ``horizon_days`` raises ok to watch.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.errors import ParameterError
+
+__all__ = ["trend", "METRICS"]
+
+K_WATCH, K_ALARM = 3.0, 6.0
+LEVELS = ("ok", "watch", "alarm")
+# task, summary column, bad direction (+1 rising, -1 falling, 0 either), floor kind, watch floor, alarm floor
+METRICS = (
+    ("diagnose", "velocity_rms_mm_s", +1, "relative", 0.5, 1.0),
+    ("diagnose", "bearing_evidence", +1, "absolute", 8.0, 12.0),
+    ("spectrum", "rms", +1, "relative", 0.5, 1.0),
+    ("ringdown", "fn1_hz", 0, "relative", 0.005, 0.01),
+    ("modes", "fn1_hz", 0, "relative", 0.005, 0.01),
+)
+ISO_VERDICT = {"A": 0, "B": 0, "C": 1, "D": 2}
+
+
+def _limits(base, direction, kind, fw, fa):
+    mu, sd = float(np.mean(base)), float(np.std(base, ddof=1)) if base.size > 1 else 0.0
+    if kind == "relative":
+        dw, da = max(K_WATCH * sd, fw * abs(mu)), max(K_ALARM * sd, fa * abs(mu))
+        return mu, sd, dw, da
+    # absolute floors: the limit is a level of the metric itself (e.g. -log10 p)
+    return mu, sd, max(K_WATCH * sd, fw - mu), max(K_ALARM * sd, fa - mu)
+
+
+def _level(v, mu, dw, da, direction):
+    dev = (v - mu) if direction > 0 else (mu - v) if direction < 0 else abs(v - mu)
+    return 2 if dev >= da else 1 if dev >= dw else 0
+
+
+def trend(store, *, asset: str | None = None, point: str | None = None, baseline_count: int = 8,
+          horizon_days: float = 90.0):
+    """Verdicts per asset, point and metric as a DataFrame (one row per metric with its baseline,
+    limits, last value, slope and std per day, projected alarm date, the times the watch and alarm
+    levels were first held over two measurements, the verdict and its reason), sorted worst
+    first. ``store`` is a path or a :class:`vibmeasure.Store`. ``df.attrs["points"]`` and
+    ``df.attrs["assets"]`` hold the roll-ups (worst verdict per point and per asset)."""
+    import pandas as pd
+    from ..io.store import Store
+    st = store if isinstance(store, Store) else Store(store)
+    if isinstance(baseline_count, bool) or not isinstance(baseline_count, (int, np.integer)) or baseline_count < 2:
+        raise ParameterError(f"baseline_count={baseline_count!r} must be an integer >= 2")
+    rows = []
+    for task, col, direction, kind, fw, fa in METRICS:
+        df = st.results(task, asset=asset, point=point)
+        if df.empty or col not in df:
+            continue
+        for (a, p), g in df.groupby(["asset", "point"], sort=True):
+            g = g[np.isfinite(pd.to_numeric(g[col], errors="coerce"))]
+            if len(g) < baseline_count + 1:
+                continue
+            y = g[col].to_numpy(float)
+            t = (g["time"] - g["time"].iloc[0]).dt.total_seconds().to_numpy() / 86400.0
+            base = y[:baseline_count]
+            mu, sd, dw, da = _limits(base, direction, kind, fw, fa)
+            lv = [_level(v, mu, dw, da, direction) for v in y[baseline_count:]]
+            level = min(lv[-2:]) if len(lv) >= 2 else min(lv[-1], 1)
+            # when each level was first reached (two measurements in a row): the alarm history
+            held = [min(lv[j - 1], lv[j]) for j in range(1, len(lv))]
+            first = {}
+            for lvl in (1, 2):
+                j = next((j for j, h in enumerate(held) if h >= lvl), None)
+                first[lvl] = None if j is None else g["time"].iloc[baseline_count + j + 1]
+            reason = f"{col} {y[-1]:.4g} against baseline {mu:.4g} +- {sd:.2g}"
+            if level:
+                reason += f" (beyond the {LEVELS[level]} limit in the last two measurements)"
+            elif lv[-1]:
+                reason += f" (one measurement beyond the {LEVELS[lv[-1]]} limit)"
+                level = 1
+            # trend over the measurements since the baseline
+            tt, yy = t[baseline_count:], y[baseline_count:]
+            slope = slope_std = np.nan
+            cross = None
+            if tt.size >= 3 and np.ptp(tt) > 0:
+                A = np.column_stack([np.ones_like(tt), tt - tt.mean()])
+                coef, res, *_ = np.linalg.lstsq(A, yy, rcond=None)
+                r = yy - A @ coef
+                s2 = float(r @ r) / max(tt.size - 2, 1)
+                slope = float(coef[1])
+                slope_std = float(np.sqrt(s2 / np.sum((tt - tt.mean()) ** 2)))
+                sign = direction if direction else (np.sign(yy[-1] - mu) or 1)
+                lim = mu + sign * da
+                if slope * sign > 2 * slope_std and slope != 0:
+                    t_cross = tt.mean() + (lim - coef[0]) / slope
+                    if t_cross > tt[-1]:
+                        cross = g["time"].iloc[0] + pd.Timedelta(days=float(t_cross))
+                        if level == 0 and t_cross - tt[-1] <= horizon_days:
+                            level = 1
+                            reason += f"; trending to the alarm limit by {cross:%Y-%m-%d}"
+            if col == "velocity_rms_mm_s" and "zone" in g:
+                z = ISO_VERDICT.get(str(g["zone"].iloc[-1]), 0)
+                if z and (len(g) < 2 or ISO_VERDICT.get(str(g["zone"].iloc[-2]), 0) >= z) and z > level:
+                    level, reason = z, reason + f"; ISO 10816-3 zone {g['zone'].iloc[-1]}"
+            sign = direction if direction else 1
+            rows.append({"asset": a, "point": p, "task": task, "metric": col, "n": len(y),
+                         "baseline_mean": mu, "baseline_std": sd, "watch_limit": mu + sign * dw,
+                         "alarm_limit": mu + sign * da, "last": float(y[-1]), "last_time": g["time"].iloc[-1],
+                         "slope_per_day": slope, "slope_std": slope_std, "alarm_date": cross,
+                         "first_watch": first[1], "first_alarm": first[2],
+                         "level": level, "verdict": LEVELS[level], "reason": reason})
+    out = pd.DataFrame(rows, columns=["asset", "point", "task", "metric", "n", "baseline_mean", "baseline_std",
+                                      "watch_limit", "alarm_limit", "last", "last_time", "slope_per_day",
+                                      "slope_std", "alarm_date", "first_watch", "first_alarm", "level",
+                                      "verdict", "reason"])
+    out = out.sort_values(["level", "asset", "point"], ascending=[False, True, True], kind="stable")
+    out = out.reset_index(drop=True)
+    pts = out.groupby(["asset", "point"])["level"].max() if not out.empty else {}
+    ass = out.groupby("asset")["level"].max() if not out.empty else {}
+    out.attrs["points"] = {f"{a}/{p}": LEVELS[int(v)] for (a, p), v in dict(pts).items()}
+    out.attrs["assets"] = {a: LEVELS[int(v)] for a, v in dict(ass).items()}
+    return out.drop(columns="level")
