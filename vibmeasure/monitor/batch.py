@@ -295,6 +295,8 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
     st = Store(store, writable=True) if own else store
     rows, todo = [], []
     try:
+        errs = st.errors()
+        failures = dict(zip(errs["measurement"], errs["message"])) if "message" in errs else {}
         for it in items:
             sha = None
             if not force:
@@ -305,8 +307,11 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
                     continue
             mid = st.has(sha) if sha else None
             if mid is not None:
+                failed = failures.get(mid)
                 rows.append({"file": it["file"], "status": "skipped", "measurement": mid,
-                             "message": "already in the store (same content); force=True to analyse again"})
+                             "message": "already in the store (same content)" +
+                                        (f"; it failed then: {failed}" if failed else "") +
+                                        "; force=True to analyse again"})
             else:
                 todo.append(it)
         total = len(todo)

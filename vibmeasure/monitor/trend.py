@@ -108,7 +108,7 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
                 z = ISO_VERDICT.get(str(g["zone"].iloc[-1]), 0)
                 if z and (len(g) < 2 or ISO_VERDICT.get(str(g["zone"].iloc[-2]), 0) >= z) and z > level:
                     level, reason = z, reason + f"; ISO 10816-3 zone {g['zone'].iloc[-1]}"
-            sign = direction if direction else 1
+            sign = direction if direction else (1 if y[-1] >= mu else -1)  # either way: the side it went
             rows.append({"asset": a, "point": p, "task": task, "metric": col, "n": len(y),
                          "baseline_mean": mu, "baseline_std": sd, "watch_limit": mu + sign * dw,
                          "alarm_limit": mu + sign * da, "last": float(y[-1]), "last_time": g["time"].iloc[-1],

@@ -1,0 +1,292 @@
+"""Condition monitoring across a fleet: the measurement store, batch analysis (serial and on a real
+Dask LocalCluster), trends and alarms."""
+
+import json
+import os
+import random
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+import vibmeasure as vm
+from vibmeasure.io import store as store_mod
+
+
+def _small_store(path, n=3, keep_raw=True):
+    rng = np.random.default_rng(0)
+    recs = []
+    with vm.Store(path, writable=True) as st:
+        st.add_asset("pump-1", bearing="6205-2RS", iso_group=2, meta={"site": "A"})
+        st.add_point("pump-1", "DE", channel="acc", direction="horizontal", unit="g")
+        for i in range(n):
+            rec = vm.Record.from_array(rng.normal(size=(2, 500)), fs=1000.0, names=["a", "b"])
+            recs.append(rec)
+            mid = st.add_measurement("pump-1", "DE", time=f"2026-01-0{i + 1}T10:00:00", rpm=1480 + i, record=rec,
+                                     keep_raw=keep_raw)
+            st.add_result(mid, "spectrum", {"peaks_hz": [24.6, 49.3]}, params={"nperseg": 256},
+                          summary={"rms": 0.1 * (i + 1), "peak1_hz": 24.6})
+    return recs
+
+
+def test_store_round_trip_is_exact(tmp_path):
+    p = tmp_path / "s.h5"
+    recs = _small_store(p)
+    st = vm.Store(p)
+    assert repr(st).startswith(f"Store({str(p)!r}: 1 assets, 1 points, 3 measurements, 3 results")
+    df = st.results("spectrum", asset="pump-1")
+    assert list(df["rms"]) == [0.1, 0.2, 0.30000000000000004]  # the floats, bit for bit
+    assert list(df["time"].dt.day) == [1, 2, 3] and str(df["time"].dt.tz) == "UTC"
+    assert df["params"][0] == {"nperseg": 256} and df["version"][0] == vm.__version__
+    assert df["result"][1] == {"peaks_hz": [24.6, 49.3]}
+    m = st.measurements()
+    assert list(m["rpm"]) == [1480.0, 1481.0, 1482.0]
+    back = st.record(m["id"][1])
+    assert np.array_equal(back.data, recs[1].data) and back.fs == 1000.0 and back.channels == recs[1].channels
+    assert st.assets()["meta"][0] == {"site": "A"}
+    assert len(st.results("spectrum", since="2026-01-02", until="2026-01-02T23:00")) == 1
+
+
+def test_store_refuses_another_schema_version(tmp_path, monkeypatch):
+    p = tmp_path / "s.h5"
+    monkeypatch.setattr(store_mod, "STORE_VERSION", 2)
+    _small_store(p, n=1)
+    monkeypatch.setattr(store_mod, "STORE_VERSION", 1)
+    with pytest.raises(vm.ParameterError, match="has store schema version 2; this vibmeasure reads version 1"):
+        vm.Store(p)
+
+
+@pytest.mark.parametrize("damage", ["flip", "truncate"])
+def test_a_damaged_store_is_a_named_error(tmp_path, damage):
+    p = tmp_path / "s.h5"
+    _small_store(p)
+    raw = bytearray(p.read_bytes())
+    if damage == "flip":
+        raw[len(raw) // 2] ^= 0x10
+    else:
+        raw = raw[: len(raw) // 2]
+    p.write_bytes(bytes(raw))
+    with pytest.raises(vm.ParameterError, match="is damaged"):
+        vm.Store(p)
+
+
+def test_a_store_that_is_not_one_is_named(tmp_path):
+    p = tmp_path / "plain.h5"
+    with h5py.File(p, "w") as f:
+        f["x"] = np.arange(3)
+    with pytest.raises(vm.ParameterError, match="not a vibmeasure store"):
+        vm.Store(p)
+    with pytest.raises(vm.ParameterError, match="does not exist"):
+        vm.Store(tmp_path / "missing.h5")
+
+
+def test_a_read_only_store_cannot_be_written(tmp_path):
+    p = tmp_path / "s.h5"
+    _small_store(p, n=1)
+    with pytest.raises(vm.ParameterError, match="open for reading"):
+        vm.Store(p).add_asset("x")
+
+
+HOLD = textwrap.dedent("""
+    import sys, time
+    import vibmeasure as vm
+    st = vm.Store(sys.argv[1], writable=True)
+    print("locked", flush=True)
+    time.sleep(float(sys.argv[2]))
+    st.close()
+""")
+
+
+def test_one_writer_at_a_time(tmp_path):
+    p = tmp_path / "s.h5"
+    proc = subprocess.Popen([sys.executable, "-c", HOLD, str(p), "1.5"], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "locked"
+        with pytest.raises(vm.StoreLockedError, match=rf"being written by pid {proc.pid} on "):
+            vm.Store(p, writable=True)
+        t0 = time.monotonic()
+        with vm.Store(p, writable=True, timeout=20) as st:  # waits for the holder to finish
+            assert time.monotonic() - t0 > 0.2
+            st.add_asset("a")
+    finally:
+        proc.wait(timeout=30)
+    assert len(vm.Store(p).assets()) == 1
+
+
+WRITER = textwrap.dedent("""
+    import sys
+    import numpy as np
+    import vibmeasure as vm
+    st = vm.Store(sys.argv[1], writable=True)
+    st.add_asset("a")
+    st.add_point("a", "p")
+    st.commit()
+    for i in range(100000):
+        n = len(st.measurements())
+        mid = st.add_measurement("a", "p", time=1.7e9 + n, record=vm.Record.from_array(np.full(2000, float(n)),
+                                 fs=100.0), keep_raw=True)
+        st.add_result(mid, "x", {"n": n}, summary={"n": n})
+        st.commit()
+        print(n + 1, flush=True)
+""")
+
+
+def test_kill_9_at_any_moment_leaves_every_committed_measurement(tmp_path):
+    # 50 writers killed at random moments: the store always opens, holds at least every measurement
+    # the writer had reported committed, and each measurement it holds is whole (result and raw data)
+    rng = random.Random(11)
+    p = tmp_path / "s.h5"
+    for trial in range(50):
+        proc = subprocess.Popen([sys.executable, "-c", WRITER, str(p)], stdout=subprocess.PIPE, text=True)
+        time.sleep(rng.uniform(0.4, 1.4))
+        proc.send_signal(signal.SIGKILL)
+        out, _ = proc.communicate()
+        reported = int(out.split()[-1]) if out.split() else 0
+        if not p.exists():
+            assert reported == 0
+            continue
+        st = vm.Store(p)
+        m = st.measurements()
+        assert len(m) >= reported
+        res = st.results("x")
+        assert len(res) == len(m)
+        for mid in m["id"][-3:]:
+            n = int(res.loc[res["measurement"] == mid, "n"].iloc[0])
+            assert np.all(st.record(mid).data == n)
+    leftovers = [f for f in os.listdir(tmp_path) if f.endswith(".part")]
+    with vm.Store(p, writable=True) as st:  # the next writer cleans what killed ones left
+        st.add_point("a", "q")
+    assert len([f for f in os.listdir(tmp_path) if f.endswith(".part")]) <= len(leftovers) and \
+        not [f for f in os.listdir(tmp_path) if f.endswith(".part")]
+
+
+# --- batch ---------------------------------------------------------------------------------------
+
+def _machines(folder, n):
+    """n small machine records (1 s at 12.8 kHz) with a manifest; every 5th with an outer-race fault."""
+    folder.mkdir()
+    lines = ["file,asset,point,rpm,bearing,time"]
+    for i in range(n):
+        fault = "bearing_outer_race" if i % 5 == 0 else "none"
+        rec = vm.synth.machine(fault=fault, rpm=1500.0, fs=12800.0, duration=1.0, seed=i, severity=0.5)
+        vm.write(folder / f"r{i:03d}.h5", rec)
+        lines.append(f"r{i:03d}.h5,m{i % 7},DE,1500,6205-2RS,2026-02-01T{i // 60:02d}:{i % 60:02d}:00")
+    (folder / "manifest.csv").write_text("\n".join(lines) + "\n")
+    return folder / "manifest.csv"
+
+
+def _by_file(store, task):
+    df = vm.Store(store).results(task)
+    st = vm.Store(store).measurements()
+    files = dict(zip(st["id"], st["file"]))
+    return {os.path.basename(files[m]): r for m, r in zip(df["measurement"], df["result"])}
+
+
+def test_batch_skips_what_is_stored_and_lists_bad_files(tmp_path):
+    man = _machines(tmp_path / "in", 6)
+    (tmp_path / "in" / "broken.h5").write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
+    with open(man, "a") as fh:
+        fh.write("broken.h5,m9,DE,1500,6205-2RS,2026-02-02T00:00:00\n")
+    rep = vm.batch(task="spectrum+diagnose", store=tmp_path / "s.h5", manifest=man)
+    assert list(rep["status"]).count("done") == 6 and list(rep["status"]).count("error") == 1
+    assert "broken.h5" in rep.loc[rep["status"] == "error", "file"].iloc[0]
+    errs = vm.Store(tmp_path / "s.h5").errors()
+    assert len(errs) == 1 and errs["failed_task"][0] == "read"
+    diag = vm.Store(tmp_path / "s.h5").results("diagnose")
+    assert list(diag["top"][diag["asset"] == "m0"]) == ["bearing_outer_race"]  # r000: the faulty one
+    again = vm.batch(task="spectrum+diagnose", store=tmp_path / "s.h5", manifest=man)
+    assert list(again["status"]).count("skipped") == 7  # same content: not analysed twice
+    assert "it failed then: " in again.loc[again["file"].str.endswith("broken.h5"), "message"].iloc[0]
+    forced = vm.batch(task="spectrum", store=tmp_path / "s.h5", manifest=man, force=True)
+    assert list(forced["status"]).count("done") == 6
+
+
+def test_manifest_rules(tmp_path):
+    (tmp_path / "m.csv").write_text("file,asset,speed\nx.h5,a,3\n")
+    with pytest.raises(vm.ParameterError, match=r"unknown column\(s\) \['speed'\]"):
+        vm.read_manifest(tmp_path / "m.csv")
+    (tmp_path / "m.csv").write_text("file,asset\nnothing*.h5,a\n")
+    with pytest.raises(vm.ParameterError, match="no file matches 'nothing\\*.h5'"):
+        vm.read_manifest(tmp_path / "m.csv")
+    with pytest.raises(vm.ParameterError, match="task='fft' must be one of"):
+        vm.batch(tmp_path, task="fft", store=tmp_path / "s.h5")
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as lc, distributed.Client(lc) as client:
+        yield client
+
+
+def test_dask_batch_equals_the_serial_run_item_by_item(tmp_path, cluster):
+    man = _machines(tmp_path / "in", 100)
+    vm.batch(task="spectrum+diagnose", store=tmp_path / "serial.h5", manifest=man)
+    rep = vm.batch(task="spectrum+diagnose", store=tmp_path / "dask.h5", manifest=man, client=cluster)
+    assert list(rep["status"]).count("done") == 100
+    for task in ("spectrum", "diagnose"):
+        a, b = _by_file(tmp_path / "serial.h5", task), _by_file(tmp_path / "dask.h5", task)
+        assert sorted(a) == sorted(b) and len(a) == 100
+        for f in a:
+            assert json.dumps(a[f], sort_keys=True) == json.dumps(b[f], sort_keys=True), f
+
+
+def test_a_worker_killed_mid_batch_loses_no_result(tmp_path, cluster):
+    man = _machines(tmp_path / "in", 40)
+    pids = list(cluster.run(os.getpid).values())
+    killed = []
+
+    def progress(done, total):
+        if done == 5 and not killed:
+            os.kill(pids[0], signal.SIGKILL)  # the nanny starts a new worker; Dask reruns its tasks
+            killed.append(pids[0])
+    rep = vm.batch(task="diagnose", store=tmp_path / "s.h5", manifest=man, client=cluster, progress=progress)
+    assert killed and list(rep["status"]).count("done") == 40
+    assert len(vm.Store(tmp_path / "s.h5").results("diagnose")) == 40
+
+
+# --- trends --------------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def fleet_store(tmp_path_factory):
+    d = tmp_path_factory.mktemp("fleet")
+    vm.synth.fleet(d / "in", n_measurements=52, fault_onset=26)
+    vm.batch(task="diagnose+spectrum", store=d / "fleet.h5", manifest=d / "in" / "machines.csv")
+    vm.batch(task="ringdown+compare", store=d / "fleet.h5", manifest=d / "in" / "structures.csv")
+    return d / "fleet.h5"
+
+
+def test_the_growing_bearing_fault_alarms_on_its_own_machine_only(fleet_store):
+    tr = vm.trend(fleet_store)
+    assert tr.attrs["assets"] == {"frame-1": "alarm", "pump-1": "ok", "pump-2": "ok", "pump-3": "alarm"}
+    healthy = tr[tr["asset"].isin(["pump-1", "pump-2"])]
+    assert (healthy["n"] >= 50).all() and healthy["first_alarm"].isna().all()  # never, over 52 each
+    be = tr[(tr["asset"] == "pump-3") & (tr["metric"] == "bearing_evidence")].iloc[0]
+    onset = vm.Store(fleet_store).measurements(asset="pump-3")["time"].iloc[26]
+    assert be["verdict"] == "alarm" and onset <= be["first_alarm"] <= onset + np.timedelta64(42, "D")
+    assert vm.Store(fleet_store).results("diagnose", asset="pump-3")["top"].iloc[-1] == "bearing_outer_race"
+
+
+def test_the_falling_stiffness_alarms_and_compare_sees_it(fleet_store):
+    tr = vm.trend(fleet_store, asset="frame-1")
+    fn = tr[tr["metric"] == "fn1_hz"].iloc[0]
+    assert fn["verdict"] == "alarm" and fn["last"] < fn["alarm_limit"] < fn["baseline_mean"]
+    assert fn["baseline_mean"] == pytest.approx(24.0, abs=0.01)  # the synthetic frame's fn
+    cmp = vm.Store(fleet_store).results("compare", asset="frame-1")
+    assert cmp["verdict"].iloc[0] == "ok" and cmp["verdict"].iloc[-1] == "alarm"  # 6 % stiffness: 3 % in fn
+
+
+def test_trend_command_and_plot(fleet_store, tmp_path):
+    from vibmeasure.cli import main
+    import io
+    out = io.StringIO()
+    assert main(["trend", str(fleet_store), "--json", "--plot", str(tmp_path / "t.png")], out=out,
+                err=io.StringIO()) == 0
+    doc = json.loads(out.getvalue())
+    assert doc["assets"]["pump-3"] == "alarm" and (tmp_path / "t.png").stat().st_size > 10_000
