@@ -237,6 +237,13 @@ def test_dask_batch_equals_the_serial_run_item_by_item(tmp_path, cluster):
             assert json.dumps(a[f], sort_keys=True) == json.dumps(b[f], sort_keys=True), f
 
 
+def test_batch_on_an_existing_cluster_by_its_scheduler_address(tmp_path, cluster):
+    man = _machines(tmp_path / "in", 10)
+    rep = vm.batch(task="spectrum", store=tmp_path / "s.h5", manifest=man, scheduler=cluster.scheduler.address)
+    assert list(rep["status"]).count("done") == 10
+    assert len(vm.Store(tmp_path / "s.h5").results("spectra")) == 10  # the plural is understood too
+
+
 def test_a_worker_killed_mid_batch_loses_no_result(tmp_path, cluster):
     man = _machines(tmp_path / "in", 40)
     pids = list(cluster.run(os.getpid).values())

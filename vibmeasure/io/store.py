@@ -32,6 +32,7 @@ __all__ = ["Store", "StoreLockedError", "STORE_SCHEMA", "STORE_VERSION"]
 STORE_SCHEMA = "vibmeasure.store"
 STORE_VERSION = 1
 TABLES = ("assets", "points", "measurements", "results")
+TASK_ALIASES = {"diagnosis": "diagnose", "modal": "modes", "spectra": "spectrum", "comparison": "compare"}
 
 
 class StoreLockedError(VibMeasureError):
@@ -217,6 +218,7 @@ class Store:
         """Results of one task as a DataFrame, oldest first: measurement, asset, point, time, task,
         version, params, the summary values as columns and ``result`` (the full result, a dict)."""
         import pandas as pd
+        task = TASK_ALIASES.get(task, task)
         rows = [r for r in self._rows["results"] + self._pending["results"] if r["task"] == task]
         flat = []
         for r in rows:

@@ -297,9 +297,10 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
     try:
         errs = st.errors()
         failures = dict(zip(errs["measurement"], errs["message"])) if "message" in errs else {}
+        known = bool(st._hashes)  # an empty store has nothing to skip: no need to hash every input twice
         for it in items:
             sha = None
-            if not force:
+            if not force and known:
                 try:
                     sha = _file_sha256(it["file"])
                 except OSError as exc:
@@ -343,9 +344,10 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
                     take(fut.result())
                     fut.release()
         finally:
-            if cluster is not None:
+            if cluster is not None:  # a client (and cluster) this call started is closed by it
                 dask_client.close()
-                cluster.close()
+                if cluster is not True:
+                    cluster.close()
         st.commit()
     finally:
         if own:
@@ -364,10 +366,18 @@ def _client(client, workers, scheduler):
     except ImportError:
         raise ParameterError("workers= and scheduler= need Dask: pip install 'vibmeasure[dask]'") from None
     if scheduler is not None:
-        return Client(scheduler), None
+        try:
+            return Client(scheduler, timeout=30), True
+        except (OSError, TimeoutError) as exc:
+            raise ParameterError(f"scheduler={scheduler!r}: no Dask scheduler answers there ({exc})") from None
     if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
         raise ParameterError(f"workers={workers!r} must be an integer >= 1")
-    cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address=None, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-                                                        "MKL_NUM_THREADS": "1"})
+    import dask
+    # one BLAS thread per worker; and no MALLOC_TRIM_THRESHOLD_ (Dask's default for its workers): with
+    # it every array above 64 kB is mapped and unmapped afresh, and the analysis of a record runs 1.5-2x
+    # slower than in a plain process (measured in benchmarks/batch.py)
+    one = {"OPENBLAS_NUM_THREADS": 1, "OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1}
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": one}):
+        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, host="127.0.0.1",
+                               dashboard_address=None)
     return Client(cluster), cluster
