@@ -129,24 +129,24 @@ def fits():
     H = np.fft.rfft(x[1]) / np.fft.rfft(x[0])
     f = np.fft.rfftfreq(x.shape[1], 1 / rec.fs)
     frf = vm.FRF(f[1:], H[1:], form="accelerance")
-    peer_name, peer = "the 3-mode idle fit (sdypy-EMA not installed)", None
+    peer_name = "the 3-mode idle fit (sdypy-EMA not installed)"
     try:
         from sdypy import EMA  # noqa: F401
         peer_name = "sdypy-EMA LSCF on the same FRF"
-
-        def peer():
-            import contextlib
-            import io
-            with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-                sel = (f >= 10) & (f <= 450)
-                m = EMA.Model(frf=H[sel][None], freq=f[sel], lower=10, upper=450, pol_order_high=40,
-                              frf_type="accelerance")
-                m.get_poles(method="lscf", show_progress=False)
     except ImportError:
-        pass
-    fns = [lambda: vm.fit_modes(frf, band=(10, 450))] + ([peer] if peer else [])
+        EMA = None
+    def sdypy_fit():
+        import contextlib
+        import io
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            sel = (f >= 10) & (f <= 450)
+            m = EMA.Model(frf=H[sel][None], freq=f[sel], lower=10, upper=450, pol_order_high=40,
+                          frf_type="accelerance")
+            m.get_poles(method="lscf", show_progress=False)
+    peer_fn = sdypy_fit if EMA is not None else None
+    fns = [lambda: vm.fit_modes(frf, band=(10, 450))] + ([peer_fn] if peer_fn else [])
     ts, outs = interleaved(fns, 5)
-    tp = ts[1] if peer else idle
+    tp = ts[1] if peer_fn else idle
     print(f"  {'vm ' + str(np.round(outs[0].fn, 2)) + ' Hz vs ' + peer_name:<52} {ts[0] * 1e3:>9.1f} ms "
           f"{tp * 1e3:>9.1f} ms {tp / ts[0]:>7.2f}x   target vm <= 300 ms")
 

@@ -21,7 +21,8 @@ def _get_controller():
     global _controller
     if _controller is None:
         try:
-            import scipy.linalg  # noqa: F401  (scipy ships its own OpenBLAS: load it so it is controlled too)
+            import importlib
+            importlib.import_module("scipy.linalg")  # scipy ships its own OpenBLAS: load it so it is controlled too
             from threadpoolctl import ThreadpoolController
             _controller = ThreadpoolController()
         except Exception:  # not installed, or a platform it cannot inspect

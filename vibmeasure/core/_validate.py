@@ -8,7 +8,33 @@ from .errors import ParameterError
 from .record import Record
 
 __all__ = ["as_record", "response_channel", "clean_signal", "check_band", "positive", "name_index",
-           "select_names", "check_range", "memory_guard", "check_memory"]
+           "select_names", "check_range", "memory_guard", "check_memory", "as_seconds"]
+
+
+def as_seconds(time, what: str = "time") -> float:
+    """A time stamp as Unix seconds: a number, an ISO 8601 string, a datetime (naive = UTC) or a
+    pandas/numpy time stamp."""
+    import datetime as _dt
+    if isinstance(time, (bool, np.bool_)):
+        raise ParameterError(f"{what}={time!r} must be seconds or a datetime, not a boolean")
+    if isinstance(time, str):
+        try:
+            time = _dt.datetime.fromisoformat(time.strip().replace("Z", "+00:00"))
+        except ValueError:
+            raise ParameterError(f"{what}={time!r} is not an ISO 8601 time") from None
+    if isinstance(time, np.datetime64):
+        time = time.astype("datetime64[ns]").astype("int64") / 1e9
+    elif isinstance(time, _dt.datetime):  # pandas.Timestamp is a datetime too
+        if time.tzinfo is None:
+            time = time.replace(tzinfo=_dt.timezone.utc)
+        time = time.timestamp()
+    try:
+        t = float(time)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{what}={time!r} must be seconds, an ISO 8601 string or a datetime") from None
+    if not np.isfinite(t):
+        raise ParameterError(f"{what}={time!r} must be finite")
+    return t
 
 
 def available_memory() -> float:

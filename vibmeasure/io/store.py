@@ -40,28 +40,8 @@ class StoreLockedError(VibMeasureError):
 
 
 def _seconds(t) -> float:
-    """Unix seconds from seconds, an ISO 8601 string, a datetime or a pandas Timestamp (naive = UTC)."""
-    import datetime as _dt
-    if isinstance(t, str):
-        import pandas as pd
-        try:
-            ts = pd.Timestamp(t)
-        except (ValueError, TypeError):
-            raise ParameterError(f"time={t!r} is not an ISO 8601 time") from None
-        t = ts.to_pydatetime()
-    if isinstance(t, _dt.datetime):
-        if t.tzinfo is None:
-            t = t.replace(tzinfo=_dt.timezone.utc)
-        return t.timestamp()
-    if hasattr(t, "timestamp") and callable(t.timestamp):
-        return float(t.timestamp())
-    try:
-        v = float(t)
-    except (TypeError, ValueError):
-        raise ParameterError(f"time={t!r} must be seconds, an ISO 8601 string or a datetime") from None
-    if not np.isfinite(v):
-        raise ParameterError(f"time={t!r} must be finite")
-    return v
+    from ..core._validate import as_seconds
+    return as_seconds(t)
 
 
 def _check_name(value, what: str) -> str:

@@ -265,23 +265,8 @@ class History:
 
 
 def _seconds(time) -> float:
-    """A time stamp as seconds: a number, a datetime (naive = UTC) or a pandas/numpy time stamp."""
-    import datetime as _dt
-    if isinstance(time, (bool, np.bool_)):
-        raise ParameterError(f"time={time!r} must be seconds or a datetime, not a boolean")
-    if isinstance(time, np.datetime64):
-        time = time.astype("datetime64[ns]").astype("int64") / 1e9
-    elif isinstance(time, _dt.datetime):  # pandas.Timestamp is a datetime too
-        if time.tzinfo is None:
-            time = time.replace(tzinfo=_dt.timezone.utc)
-        time = time.timestamp()
-    try:
-        t = float(time)
-    except (TypeError, ValueError):
-        raise ParameterError(f"time={time!r} must be seconds or a datetime") from None
-    if not np.isfinite(t):
-        raise ParameterError(f"time={time!r} must be finite")
-    return t
+    from ..core._validate import as_seconds
+    return as_seconds(time)
 
 
 class _locked:
