@@ -160,6 +160,8 @@ class Store:
                 for k in TABLES:
                     d = f[k]
                     rows[k] = [json.loads(v) for v in d.asstr()[()]] if d.shape[0] else []
+                for i, r in enumerate(rows["results"]):  # full results stay on disk until asked for
+                    r["result"], r["_row"] = None, i
         except (OSError, KeyError, ValueError, TypeError) as exc:
             if isinstance(exc, ParameterError):
                 raise
@@ -203,9 +205,21 @@ class Store:
         flat = []
         for r in rows:
             m = self._meas.get(r["measurement"], {})
+            if asset is not None and m.get("asset") != asset or point is not None and m.get("point") != point:
+                continue
             flat.append({"measurement": r["measurement"], "asset": m.get("asset"), "point": m.get("point"),
                          "time": m.get("time"), "task": r["task"], "version": r["version"],
-                         "params": r.get("params", {}), **r.get("summary", {}), "result": r.get("result")})
+                         "params": r.get("params", {}), **r.get("summary", {}), "result": r.get("result"),
+                         "_row": r.get("_row")})
+        lazy = [i for i, r in enumerate(flat) if r["_row"] is not None and r["result"] is None]
+        if lazy:
+            import h5py
+            with h5py.File(self.path, "r") as f:
+                d = f["results"].asstr()
+                for i in lazy:
+                    flat[i]["result"] = json.loads(d[flat[i]["_row"]])["result"]
+        for r in flat:
+            r.pop("_row")
         df = pd.DataFrame(flat)
         if df.empty:
             return pd.DataFrame(columns=["measurement", "asset", "point", "time", "task", "version", "params"])
@@ -379,6 +393,9 @@ class Store:
                     d.attrs["channels"] = json.dumps([{"name": c.name, "quantity": c.quantity, "unit": c.unit,
                                                        "location": c.location} for c in rec.channels])
             seal(tmp)
+        n0 = len(self._rows["results"])
+        for i, r in enumerate(self._pending["results"]):  # committed: the payload is read back when asked for
+            r["result"], r["_row"] = None, n0 + i
         for k in TABLES:
             self._rows[k] += self._pending[k]
             self._pending[k] = []

@@ -212,6 +212,9 @@ def _register(store, item, channels):
     return asset, point
 
 
+_BASELINES: dict = {}  # per open store: the first estimate of each point (read from the file once)
+
+
 def _estimate(d: dict, method: str):
     """A ModalEstimate (fn, zeta and their std) back from its stored ``to_dict()`` form."""
     from ..core.results import ModalEstimate
@@ -235,12 +238,17 @@ def _compare(store, asset, point, mid, results):
     if model:
         pred, against = vm.models.load(model), f"model {model}"
     else:
-        prev = store.results("ringdown" if "ringdown" in results else "modes", asset=asset, point=point)
-        prev = prev[prev["measurement"] != mid]
-        if prev.empty:
-            return None
-        pred = _estimate(prev.iloc[0]["result"], "baseline")
-        against = f"baseline {prev.iloc[0]['measurement']}"
+        task = "ringdown" if "ringdown" in results else "modes"
+        key = (asset, point, task)
+        if key not in _BASELINES.get(id(store), {}):
+            prev = store.results(task, asset=asset, point=point)
+            prev = prev[prev["measurement"] != mid]
+            if prev.empty:
+                return None
+            _BASELINES.setdefault(id(store), {})[key] = (_estimate(prev.iloc[0]["result"], "baseline"),
+                                                        prev.iloc[0]["measurement"])
+        pred, first = _BASELINES[id(store)][key]
+        against = f"baseline {first}"
     c = vm.compare(meas, pred)
     dev = [abs(r["fn_dev_pct"]) for r in c.rows]
     return c.to_dict(), {"verdict": c.verdict, "max_fn_dev_pct": max(dev) if dev else None}, {"against": against}
@@ -350,6 +358,7 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
                     cluster.close()
         st.commit()
     finally:
+        _BASELINES.pop(id(st), None)
         if own:
             st.close()
     import pandas as pd
