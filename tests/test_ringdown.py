@@ -285,3 +285,75 @@ def test_real_case1_hammer_response(shared_data):
     # zeta near 0.0002 and 0.0009 (one significant digit in the references): within 3 std or 10 %
     assert abs(est.zeta[i1] - 0.0002) < max(3 * est.zeta_std[i1], 2e-5)
     assert abs(est.zeta[i2] - 0.0009) < max(3 * est.zeta_std[i2], 9e-5)
+
+
+# --- backbone: fn and zeta versus amplitude (nonlinear decays) -------------------------------------
+
+def _duffing_decay(k3_over_k, zeta=0.005, fn=10.0, fs=1000.0, T=12.0, noise=1e-4, friction=0.0, seed=0):
+    from scipy.integrate import solve_ivp
+    w0 = 2 * np.pi * fn
+    k, k3, c = w0 ** 2, k3_over_k * w0 ** 2, 2 * zeta * w0
+    t = np.arange(int(T * fs)) / fs
+
+    def f(_, y):  # unit mass; dry friction smoothed over 1e-3 of the initial velocity amplitude
+        return [y[1], -c * y[1] - k * y[0] - k3 * y[0] ** 3 - friction * np.tanh(y[1] / (1e-3 * w0))]
+    sol = solve_ivp(f, (0, T), [1.0, 0.0], t_eval=t, rtol=1e-10, atol=1e-12, method="DOP853")
+    x = sol.y[0] + noise * np.random.default_rng(seed).standard_normal(t.size)
+    return vm.Record.from_array(x, fs=fs)
+
+
+def _duffing_frequency(A, k, k3):
+    """Exact frequency of the undamped Duffing oscillator x'' + k x + k3 x^3 = 0 at peak amplitude A:
+    T = 4 int_0^A dx / sqrt(k (A^2 - x^2) + k3 / 2 (A^4 - x^4)) (x = A sin u removes the singularity)."""
+    from scipy.integrate import quad
+    per = 4 * quad(lambda u: 1 / np.sqrt(k + k3 / 2 * A ** 2 * (1 + np.sin(u) ** 2)), 0, np.pi / 2)[0]
+    return 1 / per
+
+
+def test_backbone_of_a_duffing_decay_follows_the_exact_backbone():
+    # stiffening cubic spring: fn rises 1.8 % at the start. Oracle: the exact period of the undamped
+    # Duffing oscillator at each window's amplitude. Tolerance: 4 std of each window, or 2e-4 relative
+    # (the window fits the fundamental of a decaying, slightly non-sinusoidal motion: harmonics of order
+    # k3 A^2 / 32 k = 0.2 % shift the amplitude it reads)
+    k3k = 0.04 / 0.75
+    est = vm.ringdown(_duffing_decay(k3k))
+    assert "amplitude_dependent_frequency" in est.mode_flags[0]
+    bb = est.extras["backbone"]
+    assert len(bb) >= 20 and set(bb["mode"]) == {0}
+    k = (2 * np.pi * 10.0) ** 2
+    true = np.array([_duffing_frequency(a, k, k3k * k) for a in bb["amplitude"]])
+    assert np.all(np.abs(bb["fn_hz"] - true) <= np.maximum(4 * bb["fn_std_hz"], 2e-4 * true))
+    assert np.all(np.abs(bb["zeta"] - 0.005) <= 4 * bb["zeta_std"] + 2e-4)  # viscous: zeta flat
+    m = est.extras["backbone_model"][0]
+    assert m["k3_over_k"] == pytest.approx(k3k, rel=0.02)  # first-order harmonic balance: 1 % model error here
+    assert m["fn0_hz"] == pytest.approx(10.0, rel=1e-4)
+
+
+def test_backbone_of_a_linear_decay_is_flat_and_unflagged():
+    est = vm.ringdown(_duffing_decay(0.0))
+    assert "amplitude_dependent_frequency" not in est.mode_flags[0]
+    m = est.extras["backbone_model"][0]
+    assert abs(m["k3_over_k"]) < 4 * m["k3_over_k_std"] + 1e-5
+
+
+def test_backbone_of_a_decay_with_dry_friction_recovers_the_friction_term():
+    # viscous zeta 0.005 plus a friction force F (unit mass): equivalent zeta(A) = zeta + 2 F / (pi k A)
+    # (harmonic balance); the fitted friction term must match 2 F / (pi k) within 3 std + 10 %
+    F = 3.0  # friction term 2F/(pi k) = 4.8e-4: equal to the viscous zeta at A = 0.1
+    est = vm.ringdown(_duffing_decay(0.0, friction=F, T=6.0))
+    m = est.extras["backbone_model"][0]
+    k = (2 * np.pi * 10.0) ** 2
+    expect = 2 * F / (np.pi * k)
+    assert abs(m["friction_term"] - expect) <= 3 * m["friction_term_std"] + 0.1 * expect
+    bb = est.extras["backbone"]
+    assert bb["zeta"].iloc[-1] > bb["zeta"].iloc[0]  # damping ratio grows as the amplitude falls
+
+
+def test_plot_backbone_draws_both_panels_with_units():
+    import matplotlib
+    matplotlib.use("Agg")
+    from vibmeasure.plot import plot_backbone
+    est = vm.ringdown(_duffing_decay(0.04 / 0.75))
+    ax = plot_backbone(est)
+    assert ax[0].get_ylabel() == "natural frequency fn [Hz]" and ax[1].get_xlabel().startswith("amplitude [")
+    assert len(ax[0].lines) >= 1  # the model curve over the windows

@@ -351,3 +351,32 @@ def plot_trend(store, *, asset: str, point: str, metric: str, task: str | None =
     ax.legend(fontsize=8, loc="best")
     ax.figure.autofmt_xdate()
     return ax
+
+
+def plot_backbone(est: ModalEstimate, *, mode: int = 0, axes=None):
+    """The backbone of one mode of a ring-down estimate: fn and zeta versus amplitude (error bars:
+    one std per window) with the weakly nonlinear model of ``extras["backbone_model"]`` drawn over."""
+    import matplotlib.pyplot as plt
+    bb = est.extras.get("backbone")
+    if bb is None or len(bb) == 0 or mode not in set(bb["mode"]):
+        raise ParameterError(f"mode={mode} has no backbone in this estimate (too few cycles above the noise)")
+    b = bb[bb["mode"] == mode]
+    if axes is None:
+        _, axes = plt.subplots(1, 2, figsize=(9, 3.5), constrained_layout=True)
+    unit = est.unit or "-"
+    A = b["amplitude"].to_numpy(float)
+    axes[0].errorbar(A, b["fn_hz"], yerr=b["fn_std_hz"], fmt="o", ms=3, lw=1, label="windows")
+    axes[1].errorbar(A, b["zeta"], yerr=b["zeta_std"], fmt="o", ms=3, lw=1, label="windows")
+    model = est.extras.get("backbone_model", {}).get(mode)
+    if model:
+        a = np.linspace(A.min(), A.max(), 200)
+        w2 = (2 * np.pi * model["fn0_hz"]) ** 2 + 0.75 * model["k3_over_m"] * a ** 2
+        axes[0].plot(a, np.sqrt(np.maximum(w2, 0)) / (2 * np.pi), "r-", lw=1, label="Duffing model")
+        axes[1].plot(a, model["zeta_viscous"] + model["friction_term"] / a + model["quadratic_term"] * a, "r-",
+                     lw=1, label="viscous + friction + quadratic")
+    for ax, lab in zip(axes, ("natural frequency fn [Hz]", "damping ratio zeta [-]")):
+        ax.set_xlabel(f"amplitude [{unit}]")
+        ax.set_ylabel(lab)
+        ax.legend(fontsize=8)
+    axes[0].set_title(f"backbone of the {est.fn[mode]:.4g} Hz mode", fontsize=10)
+    return axes

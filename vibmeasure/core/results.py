@@ -23,6 +23,8 @@ FLAG_TEXT = {
     "coulomb_friction": "the envelope decays linearly, as with dry (Coulomb) friction: viscous zeta does "
                         "not describe it; see friction decay per cycle",
     "amplitude_dependent": "damping changes with amplitude (nonlinear damping); zeta is an average",
+    "amplitude_dependent_frequency": "the natural frequency changes with amplitude (nonlinear stiffness); fn is "
+                                     "an average: see extras['backbone'] and extras['backbone_model']",
     "colored_noise": "the noise near this mode is stronger than the broadband level: std scaled up",
     "low_snr": "the mode is weak compared with the noise",
     "start_detected": "the decay starts after the beginning of the record (trigger/impact found)",
@@ -141,6 +143,8 @@ def _num(x):
 
 
 def _jsonable(obj):
+    if hasattr(obj, "to_dict") and hasattr(obj, "columns"):  # a pandas DataFrame: its rows
+        return [_jsonable(r) for r in obj.to_dict(orient="records")]
     if isinstance(obj, Mapping):
         return {str(k): _jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):

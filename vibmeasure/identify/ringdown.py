@@ -345,13 +345,14 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
 
     # --- damping that changes with amplitude: one mode, described by a table ------------------
     nl_pre = _amplitude_check(x, fsr, band, pre) if pre is not None else {}
-    if nl_pre.get("amplitude_dependent") and n_modes is None:
+    if (nl_pre.get("amplitude_dependent") or nl_pre.get("frequency_dependent")) and n_modes is None:
         # a sum of close 'modes' would mimic the non-exponential envelope: fit one mode instead
         n_modes = 1
         if band is None:
             band = (0.8 * nl_pre["fd"], min(1.2 * nl_pre["fd"], 0.499 * fsr))
-        notes.append("damping changes with amplitude: one mode fitted in "
-                     f"{band[0]:.4g}-{band[1]:.4g} Hz; zeta is an average over the decay")
+        what = "damping" if nl_pre.get("amplitude_dependent") else "frequency"
+        notes.append(f"{what} changes with amplitude: one mode fitted in "
+                     f"{band[0]:.4g}-{band[1]:.4g} Hz; fn and zeta are averages over the decay (see the backbone)")
 
     tick(0.15)
     # --- start values and model order -----------------------------------------------------
@@ -565,6 +566,16 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
         mode_flags[pos].append("amplitude_dependent")
     if "zeta_vs_amplitude" in nl:
         extras["zeta_vs_amplitude"] = nl["zeta_vs_amplitude"]
+    resid_all = x - model
+    tables = []
+    for j, k in enumerate(ik):  # every reported mode, isolated from the others
+        if np.isfinite(zeta_r[j]):
+            tables.append(_add_backbone(extras, mode_flags[j], resid_all + _mode_model(p, k, t), fsr, fn[k], zeta[k],
+                                        noise, j))
+    tables = [b for b in tables if b is not None]
+    if tables:
+        import pandas as pd
+        extras["backbone"] = pd.concat(tables, ignore_index=True)
     if np.any(fn_r >= 0.499 * fsr):
         raise FitError(f"ringdown: a mode at {float(np.max(fn_r)):.4g} Hz is at the Nyquist limit (fs/2 = {fsr / 2:g} Hz): "
                        "aliased or unresolved; sample faster (at least 10 x the frequency)")
@@ -575,6 +586,25 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     _warn_flags(est, rejected)
     tick(1.0)
     return est
+
+
+def _add_backbone(extras, flags, iso, fs, fn, zeta, noise, j):
+    """fn and zeta versus amplitude of reported mode j (isolated from the others; a table with a
+    ``mode`` column), its weakly nonlinear model in extras["backbone_model"][j], and the flag
+    amplitude_dependent_frequency when fn moves significantly (slope on log amplitude above 4 std)
+    by more than 1e-4 over the amplitude range."""
+    from .backbone import backbone, fit_backbone, frequency_trend
+    bb = backbone(iso, fs, fn=fn, zeta=zeta, noise=noise)
+    if bb.empty:
+        return None
+    bb.insert(0, "mode", j)
+    if len(bb) >= 4:
+        extras.setdefault("backbone_model", {})[j] = fit_backbone(bb)
+        change, signif = frequency_trend(bb)
+        if signif > 4 and abs(change) > 1e-4:
+            flags.append("amplitude_dependent_frequency")
+            extras.setdefault("frequency_change_over_decay", {})[j] = change
+    return bb
 
 
 def _mode_shares(p, A, nm, t_end):
@@ -690,12 +720,29 @@ def _nonlinear_damping(x, fs, fd, noise, t_end):
         return out
     # local damping over groups of cycles
     g = max(3, tp.size // 8)
-    rows = []
+    rows, freqs = [], []
     for i in range(0, tp.size - g + 1, g):
         tt, aa = tp[i:i + g], ap[i:i + g]
         sl = np.polyfit(tt, np.log(aa), 1)[0]
         delta = -sl / fd
         rows.append((float(np.exp(np.mean(np.log(aa)))), float(delta / np.sqrt(4 * np.pi ** 2 + delta ** 2))))
+        # the group's own frequency: half cycles counted between its first and last extreme
+        halves = np.round((tt[-1] - tt[0]) * 2 * fd)
+        freqs.append(halves / (2 * (tt[-1] - tt[0])) if tt[-1] > tt[0] else np.nan)
+    fq = np.asarray(freqs)
+    if len(rows) >= 4 and np.isfinite(fq).all():
+        # frequency versus amplitude: a stiffening or softening structure chirps as it decays, and a
+        # sum of close 'modes' would mimic that; the slope on log amplitude must stand out of the
+        # groups' scatter (4 std) and move fn by more than 0.2 %
+        amp = np.array([r[0] for r in rows])
+        for X in (np.log(amp), amp ** 2):  # friction-like (log) or cubic-stiffness-like (A^2) trends
+            if np.ptp(X) <= 0:
+                continue
+            c = np.polyfit(X, fq, 1)
+            res = fq - np.polyval(c, X)
+            se = np.sqrt(res @ res / max(len(rows) - 2, 1) / np.sum((X - X.mean()) ** 2)) + 1e-300
+            if abs(c[0]) / se > 4 and abs(c[0]) * np.ptp(X) > 2e-3 * np.mean(fq):
+                out["frequency_dependent"] = True
     if len(rows) >= 3:
         amp_g = np.array([r[0] for r in rows])
         z_g = np.array([r[1] for r in rows])

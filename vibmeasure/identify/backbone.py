@@ -1,0 +1,162 @@
+"""Backbone of a nonlinear free decay: natural frequency and damping versus amplitude, and the
+weakly nonlinear SDOF model (Duffing stiffness, amplitude-dependent damping) that explains it.
+
+Real structures soften or stiffen and their damping changes as the vibration dies out. Over a window
+of a few cycles the decay is still a damped sinusoid, so fitting one by maximum likelihood on
+overlapping windows gives fn and zeta at the window's amplitude, each with its std from the window's
+Fisher information. The backbone is that table.
+
+The model (first-order harmonic balance / averaging, amplitude A of the displacement-like signal):
+    wn(A)^2   = w0^2 + (3/4) (k3/m) A^2                       (cubic stiffness k3)
+    zeta(A)   = zeta_v + f_c / A + q A                          (viscous, dry friction, quadratic)
+with f_c = 2 F_c / (pi k) and q = 4 c2 w / (3 pi k) in terms of the friction force F_c and the
+quadratic damping coefficient c2; both relations are linear in their unknowns, fitted by weighted
+least squares with the windows' std, and returned with their std.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.errors import ParameterError
+from ._poles import pole_to_modal
+
+__all__ = ["backbone", "fit_backbone"]
+
+MIN_CYCLES = 6      # cycles per window: enough for fn and zeta, short enough to follow the amplitude
+MAX_WINDOWS = 40    # long decays use longer windows: the cost stays linear in the record
+SNR_STOP = 10.0     # windows end where the amplitude falls below this many of its own std
+MAX_SAMPLES = 4096  # samples per window fit (longer windows are subsampled)
+
+
+def _window_fit(y, t, sig, om):
+    """ML fit of a*e^{-s t}cos(w t) + b*e^{-s t}sin(w t) + c on one window: (p, cov, rss) or None."""
+    p = np.array([sig, om, 0.0, 0.0, 0.0])
+    for _ in range(12):
+        e = np.exp(-p[0] * t)
+        c, s = e * np.cos(p[1] * t), e * np.sin(p[1] * t)
+        A = np.column_stack([c, s, np.ones_like(t)])
+        lin, *_ = np.linalg.lstsq(A, y, rcond=None)
+        p[2:] = lin
+        m = A @ lin
+        J = np.column_stack([-t * (lin[0] * c + lin[1] * s), t * (lin[1] * c - lin[0] * s), c, s, np.ones_like(t)])
+        r = y - m
+        try:
+            step = np.linalg.lstsq(J, r, rcond=None)[0]
+        except np.linalg.LinAlgError:
+            return None
+        p[:2] += step[:2]
+        if abs(step[1]) < 1e-9 * abs(p[1]) and abs(step[0]) < 1e-9 * abs(p[1]):
+            break
+    e = np.exp(-p[0] * t)
+    c, s = e * np.cos(p[1] * t), e * np.sin(p[1] * t)
+    A = np.column_stack([c, s, np.ones_like(t)])
+    lin, *_ = np.linalg.lstsq(A, y, rcond=None)
+    p[2:] = lin
+    r = y - A @ lin
+    J = np.column_stack([-t * (lin[0] * c + lin[1] * s), t * (lin[1] * c - lin[0] * s), c, s, np.ones_like(t)])
+    rss = float(r @ r)
+    try:
+        cov = rss / max(t.size - 5, 1) * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        return None
+    return p, cov, rss
+
+
+def backbone(x, fs: float, *, fn: float, zeta: float, noise: float, cycles: float | None = None):
+    """fn and zeta versus amplitude of a one-mode decay ``x`` (the mode isolated: other modes and
+    offsets removed), from ML fits on half-overlapping windows. Returns a DataFrame with t_s,
+    amplitude (at the window's centre), fn_hz, fn_std_hz, zeta, zeta_std; empty when fewer than three
+    windows measure their amplitude to better than 1/SNR_STOP (``noise`` is the per-sample std)."""
+    import pandas as pd
+    cols = ["t_s", "amplitude", "fn_hz", "fn_std_hz", "zeta", "zeta_std"]
+    x = np.asarray(x, float)
+    if not (np.isfinite(fn) and fn > 0 and np.isfinite(zeta) and 0 < zeta < 1):
+        return pd.DataFrame(columns=cols)
+    wn = 2 * np.pi * fn
+    sig, om = zeta * wn, wn * np.sqrt(1 - zeta ** 2)
+    a0 = np.max(np.abs(x[: max(int(fs / fn), 8)]))
+    # a window of n samples measures an amplitude to about noise * sqrt(2 / n): the decay is followed
+    # until the amplitude is SNR_STOP times that, for the shortest window, at the global decay rate
+    floor = SNR_STOP * max(noise, 1e-300) * np.sqrt(2 / max(MIN_CYCLES * fs / fn, 1.0))
+    t_alive = min(x.size / fs, np.log(max(a0 / floor, 1.0)) / max(sig, 1e-300))
+    cyc_alive = fn * t_alive
+    per_win = max(MIN_CYCLES, cyc_alive / (MAX_WINDOWS / 2 + 1)) if cycles is None else float(cycles)
+    nw = int(round(per_win * fs / fn))
+    step = max(nw // 2, 1)
+    rows = []
+    for s0 in range(0, max(int(t_alive * fs) - nw + 1, 0), step):
+        y = x[s0:s0 + nw]
+        if y.size < nw:
+            break
+        tc = (nw - 1) / (2 * fs)
+        t = np.arange(nw) / fs - tc  # centred: amplitudes refer to the window's middle
+        q = max(1, nw // MAX_SAMPLES)  # every q-th sample keeps the model exact; the std says what it costs
+        out = _window_fit(y[::q], t[::q], sig, om)
+        if out is None:
+            continue
+        p, cov, _ = out
+        amp = float(np.hypot(p[2], p[3]))
+        amp_std = float(np.sqrt(max(cov[2, 2] + cov[3, 3], 0) / 2))
+        if amp < SNR_STOP * amp_std:
+            break
+        if p[0] <= 0:
+            continue
+        f_n, z, f_std, z_std = pole_to_modal(p[0], abs(p[1]), cov[:2, :2])
+        rows.append((s0 / fs + tc, amp, f_n, f_std, z, z_std))
+    df = pd.DataFrame(rows, columns=cols)
+    return df if len(df) >= 3 else pd.DataFrame(columns=cols)
+
+
+def fit_backbone(bb) -> dict:
+    """The weakly nonlinear SDOF model of a backbone table (see the module doc): w0, k3/m (and k3/k
+    = k3/(m w0^2)), zeta_v, the friction term f_c and the quadratic term q, each with its std; and
+    the reduced chi-square of each fit (about 1 when the model explains the backbone within its std)."""
+    import pandas as pd
+    if not isinstance(bb, pd.DataFrame) or not {"amplitude", "fn_hz", "fn_std_hz", "zeta", "zeta_std"} <= set(bb):
+        raise ParameterError("bb must be a backbone DataFrame (amplitude, fn_hz, fn_std_hz, zeta, zeta_std)")
+    if len(bb) < 4:
+        raise ParameterError(f"a backbone model needs at least 4 windows, got {len(bb)}")
+    A = bb["amplitude"].to_numpy(float)
+    w = 2 * np.pi * bb["fn_hz"].to_numpy(float)
+    w_std = 2 * np.pi * np.maximum(bb["fn_std_hz"].to_numpy(float), 1e-300)
+    z = bb["zeta"].to_numpy(float)
+    z_std = np.maximum(bb["zeta_std"].to_numpy(float), 1e-300)
+
+    def wls(X, y, s):
+        Xw, yw = X / s[:, None], y / s
+        coef, *_ = np.linalg.lstsq(Xw, yw, rcond=None)
+        r = yw - Xw @ coef
+        chi2 = float(r @ r) / max(len(y) - X.shape[1], 1)
+        cov = np.linalg.pinv(Xw.T @ Xw) * max(chi2, 1.0)  # scatter beyond the stated std widens it
+        return coef, np.sqrt(np.diag(cov)), chi2
+
+    # w^2 = w0^2 + (3/4)(k3/m) A^2, with std(w^2) = 2 w std(w)
+    cw, sw, chi_w = wls(np.column_stack([np.ones_like(A), 0.75 * A ** 2]), w ** 2, 2 * w * w_std)
+    w0 = float(np.sqrt(max(cw[0], 1e-300)))
+    cz, sz, chi_z = wls(np.column_stack([np.ones_like(A), 1 / A, A]), z, z_std)
+    return {"fn0_hz": w0 / (2 * np.pi), "fn0_std_hz": float(sw[0] / (2 * w0) / (2 * np.pi)),
+            "k3_over_m": float(cw[1]), "k3_over_m_std": float(sw[1]),
+            "k3_over_k": float(cw[1] / w0 ** 2), "k3_over_k_std": float(sw[1] / w0 ** 2),
+            "zeta_viscous": float(cz[0]), "zeta_viscous_std": float(sz[0]),
+            "friction_term": float(cz[1]), "friction_term_std": float(sz[1]),
+            "quadratic_term": float(cz[2]), "quadratic_term_std": float(sz[2]),
+            "chi2_frequency": chi_w, "chi2_damping": chi_z}
+
+
+def frequency_trend(bb) -> tuple[float, float]:
+    """Relative change of fn over the backbone's amplitude range and its significance (slope of fn
+    on log amplitude over its std): the test behind the flag amplitude_dependent_frequency."""
+    if len(bb) < 4:
+        return 0.0, 0.0
+    X = np.log(bb["amplitude"].to_numpy(float))
+    y = bb["fn_hz"].to_numpy(float)
+    s = np.maximum(bb["fn_std_hz"].to_numpy(float), 1e-300)
+    if np.ptp(X) <= 0:
+        return 0.0, 0.0
+    M = np.column_stack([np.ones_like(X), X]) / s[:, None]
+    coef, *_ = np.linalg.lstsq(M, y / s, rcond=None)
+    r = y / s - M @ coef
+    chi2 = max(float(r @ r) / max(len(y) - 2, 1), 1.0)
+    se = float(np.sqrt(np.linalg.pinv(M.T @ M)[1, 1] * chi2))
+    return float(coef[1] * np.ptp(X) / np.mean(y)), float(abs(coef[1]) / max(se, 1e-300))
