@@ -207,11 +207,8 @@ def _main_trend(args, out, err) -> int:
     if args.plot:
         if tr.empty:
             raise VibMeasureError("nothing to plot: no trended metric")
-        import matplotlib
-        matplotlib.use("Agg")
-        from .plot import plot_trend
         r = tr.iloc[0]
-        ax = plot_trend(args.store, asset=r["asset"], point=r["point"], metric=r["metric"], task=r["task"],
+        ax = _plot_module().plot_trend(args.store, asset=r["asset"], point=r["point"], metric=r["metric"], task=r["task"],
                         baseline_count=args.baseline)
         _save_figure(ax.figure, args.plot)
         print(f"vibmeasure: wrote {args.plot}", file=err)
@@ -236,10 +233,7 @@ def _main_diagnose(args, out, err) -> int:
                         foundation=args.foundation, channel=0, line_frequency=args.line_frequency,
                         prewhitening=tuple(args.prewhitening))
         if args.plot:
-            import matplotlib
-            matplotlib.use("Agg")
-            from .plot import plot_diagnosis
-            axes = plot_diagnosis(rec, diag)
+            axes = _plot_module().plot_diagnosis(rec, diag)
             _save_figure(axes[0].figure, args.plot)
     except (VibMeasureError, OSError) as exc:
         print(f"vibmeasure: error: {exc}", file=err)
@@ -319,18 +313,10 @@ def _main_compare(args, out, err) -> int:
                 est = rd.ringdown(rec, channel=args.channel, band=band)
             cmp = compare(est, pred, rtol_fn=args.rtol_fn)
             if args.plot:
-                import matplotlib
-                matplotlib.use("Agg")
-                import matplotlib.pyplot as plt
-                fig, ax = plt.subplots(figsize=(7, 4))
-                colors = {"ok": "C2", "watch": "C1", "alarm": "C3"}
-                for r in cmp.rows:
-                    ax.bar(f"{r['fn_predicted_hz']:.4g} Hz", r["fn_dev_pct"], color=colors[r["verdict"]])
-                ax.axhline(0, color="k", lw=0.6)
-                for sgn in (-1, 1):
-                    ax.axhline(sgn * args.rtol_fn * 100, color="C3", ls="--", lw=0.8)
-                ax.set_ylabel("fn deviation [%]")
-                ax.set_title(f"measured vs {'baseline' if args.baseline else 'model'}: {cmp.verdict}", fontsize=9)
+                plot = _plot_module()
+                ax = plot.plot_comparison(cmp, rtol_fn=args.rtol_fn,
+                                          against="baseline" if args.baseline else "model")
+                fig = ax.figure
                 _save_figure(fig, args.plot)
         except (VibMeasureError, OSError) as exc:
             print(f"vibmeasure: error: {exc}", file=err)
@@ -390,14 +376,12 @@ def _main_frf(args, out, err) -> int:
                 from .identify.modal import fit_modes
                 est = fit_modes(frf, band=tuple(args.band), n_modes=args.modes, max_order=args.max_order)
             if args.plot:
-                import matplotlib
-                matplotlib.use("Agg")
-                from .plot import plot_frf, plot_stabilisation
+                plot = _plot_module()
                 if est is not None:
-                    ax = plot_stabilisation(est, frf=frf)
+                    ax = plot.plot_stabilisation(est, frf=frf)
                     fig = ax.figure
                 else:
-                    fig = plot_frf(frf)[0].figure
+                    fig = plot.plot_frf(frf)[0].figure
                 _save_figure(fig, args.plot)
         except (VibMeasureError, OSError) as exc:
             print(f"vibmeasure: error: {exc}", file=err)
@@ -502,38 +486,26 @@ def _spectrum_outputs(args, spec, found, band):
         with atomic_path(args.csv) as tmp:
             df.to_csv(tmp, index=False, float_format="%.10g")
     if args.plot:
-        import matplotlib
-        matplotlib.use("Agg")
-        from .plot import plot_spectrum
-        ax = plot_spectrum(spec, peaks=found[0] if found else None)
+        ax = _plot_module().plot_spectrum(spec, peaks=found[0] if found else None)
         if band:
             ax.set_xlim(*band)
         _save_figure(ax.figure, args.plot)
 
 
+def _plot_module():
+    """plot.py with matplotlib's file backend selected: the command line only writes pictures."""
+    from . import plot
+    plot.file_backend()
+    return plot
+
+
 def _save_figure(fig, path):
     """Write the figure atomically, then close it (also when writing fails)."""
-    import matplotlib.pyplot as plt
+    from .plot import save_figure
     try:
-        _atomic_savefig(fig, path)
-    finally:
-        plt.close(fig)
-
-
-def _atomic_savefig(fig, path):
-    import os
-    import tempfile
-    p = Path(path)
-    if not p.parent.exists():
-        raise VibMeasureError(f"{path!r}: folder {str(p.parent)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=p.suffix or ".png", dir=p.parent)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=120, bbox_inches="tight")
-        os.replace(tmp, p)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        save_figure(fig, path)
+    except ValueError as exc:
+        raise VibMeasureError(str(exc)) from None
 
 
 def _ringdown(args, out, err=None):
@@ -572,10 +544,7 @@ def _ringdown(args, out, err=None):
 
 
 def _save_plot(path, rec, est):
-    import matplotlib
-    matplotlib.use("Agg")
-    from .plot import plot_ringdown
-    ax, _ = plot_ringdown(rec, est)
+    ax, _ = _plot_module().plot_ringdown(rec, est)
     _save_figure(ax.figure, path)
 
 

@@ -380,3 +380,51 @@ def plot_backbone(est: ModalEstimate, *, mode: int = 0, axes=None):
         ax.legend(fontsize=8)
     axes[0].set_title(f"backbone of the {est.fn[mode]:.4g} Hz mode", fontsize=10)
     return axes
+
+
+def file_backend() -> None:
+    """Select matplotlib's file backend (Agg), for programs that only write pictures (the CLI)."""
+    import matplotlib
+    matplotlib.use("Agg")
+
+
+def save_figure(fig, path, *, dpi: int = 120) -> None:
+    """Write a figure atomically (never a half-written picture), then close it, also on failure."""
+    import os
+    import tempfile
+    from pathlib import Path
+    import matplotlib.pyplot as plt
+    p = Path(path)
+    try:
+        if not p.parent.exists():
+            raise ParameterError(f"{str(path)!r}: folder {str(p.parent)!r} does not exist")
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=p.suffix or ".png", dir=p.parent)
+        os.close(fd)
+        try:
+            fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
+            os.replace(tmp, p)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    finally:
+        plt.close(fig)
+
+
+def plot_comparison(cmp, *, rtol_fn: float = 0.02, against: str = "model", ax=None):
+    """Deviation of each measured fn from its prediction (%), coloured by verdict, with the alarm
+    tolerance +-rtol_fn and, where known, one-std error bars."""
+    import matplotlib.pyplot as plt
+    if ax is None:
+        _, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
+    colors = {"ok": "C2", "watch": "C1", "alarm": "C3"}
+    for r in cmp.rows:
+        sd = r.get("fn_dev_std")
+        err = abs(r["fn_dev_pct"] / sd) if sd not in (None, 0) and np.isfinite(sd) else None
+        ax.bar(f"{r['fn_predicted_hz']:.4g} Hz", r["fn_dev_pct"], color=colors[r["verdict"]], yerr=err, capsize=3)
+    ax.axhline(0, color="k", lw=0.6)
+    for sgn in (-1, 1):
+        ax.axhline(sgn * rtol_fn * 100, color="C3", ls="--", lw=0.8)
+    ax.set_ylabel("fn deviation [%]")
+    ax.set_xlabel("predicted mode")
+    ax.set_title(f"measured vs {against}: {cmp.verdict}", fontsize=9)
+    return ax

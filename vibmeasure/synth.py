@@ -13,8 +13,9 @@ from .core import units as _units
 from .core._validate import positive
 from .core.errors import ParameterError
 from .core.record import Channel, Record
+from .models.sdof import coulomb_response  # noqa: F401  (public here too: synth.coulomb_response)
 
-__all__ = ["free_decay", "coulomb_decay", "noise_std_for_snr", "machine", "fleet"]
+__all__ = ["free_decay", "coulomb_decay", "coulomb_response", "noise_std_for_snr", "machine", "fleet"]
 
 _ORDER = {"displacement": 0, "velocity": 1, "acceleration": 2}
 
@@ -119,38 +120,6 @@ def free_decay(*, fn, zeta, fs: float, duration: float, amplitude=1.0, phase=0.0
              "phase": phase.tolist(), "quantity": quantity}
     return _finish(x, t, fs=fs, quantity=quantity, unit=unit, snr_db=snr_db, noise_std=noise_std,
                    ref_amp=max(env), clip=clip, dc_offset=dc_offset, drift=drift, seed=seed, name=name, truth=truth)
-
-
-def coulomb_response(t, *, fn: float, friction_decay: float, amplitude: float, order: int = 0) -> np.ndarray:
-    """Closed-form dry-friction decay released from rest at ``amplitude`` at t = 0 (t >= 0).
-
-    Each half cycle is a cosine about a centre shifted by the friction displacement mu = F/k
-    (= friction_decay / 4) against the motion; the turning amplitude falls by 2 mu per half cycle
-    until it is below mu and the mass sticks. ``order`` 1 and 2 give velocity and acceleration.
-    """
-    t = np.asarray(t, dtype=float)
-    mu = friction_decay / 4.0
-    wn = 2 * np.pi * fn
-    half = np.pi / wn
-    x = np.zeros_like(t)
-    a, side = abs(float(amplitude)), (1.0 if amplitude >= 0 else -1.0)
-    k = np.floor(np.maximum(t, 0.0) / half).astype(int)
-    n_half = int(k.max()) + 1 if t.size else 0
-    for j in range(n_half):
-        r = a - mu  # amplitude about the shifted centre
-        seg = k == j
-        if r <= 0:  # stuck: friction holds the mass where it turned
-            x[k >= j] = side * a if order == 0 else 0.0
-            break
-        tau = t[seg] - j * half
-        if order == 0:
-            x[seg] = side * (mu + r * np.cos(wn * tau))
-        elif order == 1:
-            x[seg] = -side * r * wn * np.sin(wn * tau)
-        else:
-            x[seg] = -side * r * wn ** 2 * np.cos(wn * tau)
-        a, side = r - mu, -side
-    return x
 
 
 def coulomb_decay(*, fn: float, friction_decay: float, fs: float, duration: float, amplitude: float = 1.0,

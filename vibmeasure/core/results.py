@@ -283,6 +283,14 @@ class Peaks:
 _FORM_ORDER = {"receptance": 0, "mobility": 1, "accelerance": 2}
 
 
+FORM_OF_QUANTITY = {"displacement": "receptance", "velocity": "mobility", "acceleration": "accelerance"}
+
+
+def form_of(quantity: str) -> str:
+    """FRF form for an output quantity (acceleration -> accelerance); 'unknown' otherwise."""
+    return FORM_OF_QUANTITY.get(quantity, "unknown")
+
+
 @dataclass(frozen=True)
 class FRF:
     """Frequency response functions: complex ``h`` (n_out, n_in, n_freq) at ``freq`` (Hz).

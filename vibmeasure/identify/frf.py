@@ -14,19 +14,13 @@ import numpy as np
 from ..core._validate import as_record
 from ..core.errors import ParameterError, warn_quality
 from ..core.record import Record
-from ..core.results import FRF
+from ..core.results import FRF, form_of
 from ..signal.spectral import _check_params, _segment_sums, get_window
 from ._decay import clipped_mask
 
 __all__ = ["estimate_frf", "impact_frf", "find_hits", "form_of"]
 
-_FORM = {"displacement": "receptance", "velocity": "mobility", "acceleration": "accelerance"}
 DOUBLE_HIT = 0.2   # a second pulse above 20 % of the first after it has ended is a double hit
-
-
-def form_of(quantity: str) -> str:
-    """FRF form for an output quantity (acceleration -> accelerance); 'unknown' otherwise."""
-    return _FORM.get(quantity, "unknown")
 
 
 def _io(rec: Record, input, outputs):

@@ -808,7 +808,7 @@ def _coulomb_check(x, fs, rec, idx, flags, i0, how, pre):
     # maximum likelihood on the closed-form dry-friction response, released at the first turning
     # point: frequency, friction decay, amplitude, release time and offset
     from scipy.optimize import least_squares
-    from ..synth import coulomb_response
+    from ..models.sdof import coulomb_response
     te0 = icpt - half * np.floor(icpt / half)  # the earliest turning point in the record
     i_a = max(0, int(np.ceil(te0 * fs)))
     t = np.arange(x.size) / fs

@@ -97,7 +97,7 @@ def read_uff(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
 def read_frf_uff(path):
     """FRFs (function type 4) of a UFF 58 file: one output per dataset, inputs by reference."""
     from ..core.results import FRF
-    from ..identify.frf import form_of
+    from ..core.results import form_of
     src = f"UFF file {str(path)!r}"
     sets = [d for d in _sets(path) if int(d.get("func_type", 0)) == 4]
     if not sets:

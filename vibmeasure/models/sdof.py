@@ -12,9 +12,42 @@ from ..core._validate import positive
 from ..core.errors import ParameterError
 from ..core.results import ModalEstimate
 
-__all__ = ["SDOF"]
+__all__ = ["SDOF", "coulomb_response"]
 
 _FORMS = {"receptance": 0, "mobility": 1, "accelerance": 2}
+
+
+
+def coulomb_response(t, *, fn: float, friction_decay: float, amplitude: float, order: int = 0) -> np.ndarray:
+    """Closed-form dry-friction decay released from rest at ``amplitude`` at t = 0 (t >= 0).
+
+    Each half cycle is a cosine about a centre shifted by the friction displacement mu = F/k
+    (= friction_decay / 4) against the motion; the turning amplitude falls by 2 mu per half cycle
+    until it is below mu and the mass sticks. ``order`` 1 and 2 give velocity and acceleration.
+    """
+    t = np.asarray(t, dtype=float)
+    mu = friction_decay / 4.0
+    wn = 2 * np.pi * fn
+    half = np.pi / wn
+    x = np.zeros_like(t)
+    a, side = abs(float(amplitude)), (1.0 if amplitude >= 0 else -1.0)
+    k = np.floor(np.maximum(t, 0.0) / half).astype(int)
+    n_half = int(k.max()) + 1 if t.size else 0
+    for j in range(n_half):
+        r = a - mu  # amplitude about the shifted centre
+        seg = k == j
+        if r <= 0:  # stuck: friction holds the mass where it turned
+            x[k >= j] = side * a if order == 0 else 0.0
+            break
+        tau = t[seg] - j * half
+        if order == 0:
+            x[seg] = side * (mu + r * np.cos(wn * tau))
+        elif order == 1:
+            x[seg] = -side * r * wn * np.sin(wn * tau)
+        else:
+            x[seg] = -side * r * wn ** 2 * np.cos(wn * tau)
+        a, side = r - mu, -side
+    return x
 
 
 class SDOF:
@@ -118,7 +151,6 @@ class SDOF:
     def coulomb_free_response(self, t, *, x0: float, friction_force: float) -> np.ndarray:
         """Dry friction F instead of viscous damping, released from rest at x0: the amplitude falls
         by 4 F / k per cycle at wn and stops once it is below F / k."""
-        from ..synth import coulomb_response
         f = positive(friction_force, "friction_force")
         return coulomb_response(t, fn=self.fn, friction_decay=4 * f / self.k, amplitude=x0)
 
