@@ -77,6 +77,7 @@ _LAZY = {
     "batch": (".monitor.batch", "batch"),
     "read_manifest": (".monitor.batch", "read_manifest"),
     "trend": (".monitor.trend", "trend"),
+    "report": (".reporting", "report"),
     "models": (".", "models"),
     "synth": (".", "synth"),
 }
@@ -107,5 +108,5 @@ __all__ = [
     "ringdown", "ringdown_crb", "estimate_frf", "impact_frf", "find_hits", "fit_modes", "circle_fit", "mac",
     "modal_crb", "synthesize_frf", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
     "compare", "Comparison", "History", "diagnose", "Diagnosis", "severity_zone", "Bearing", "Gear", "BEARINGS",
-    "Store", "StoreLockedError", "batch", "read_manifest", "trend", "models", "synth", "units", "__version__",
+    "Store", "StoreLockedError", "batch", "read_manifest", "trend", "report", "models", "synth", "units", "__version__",
 ]

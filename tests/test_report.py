@@ -1,0 +1,137 @@
+"""HTML reports and the demo: each input kind, bad inputs, and the demo report in a real browser
+(headless Chromium from the system's package manager)."""
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from html.parser import HTMLParser
+
+import numpy as np
+import pytest
+
+import vibmeasure as vm
+from vibmeasure.reporting import demo
+
+
+class _Page(HTMLParser):
+    """Tags, attributes and text of a page; raises on nothing, records what a report must not hold."""
+
+    def __init__(self):
+        super().__init__()
+        self.tags, self.text, self.external = [], [], []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append(tag)
+        for k, v in attrs:
+            if k in ("src", "href") and v and not v.startswith(("#", "data:")):
+                self.external.append((tag, k, v))  # an <image href> in an SVG, a <link href>, a <script src>
+
+    def handle_data(self, data):
+        self.text.append(data)
+
+
+def _parse(path):
+    html = path.read_text(encoding="utf-8")
+    page = _Page()
+    page.feed(html)
+    page.close()
+    assert not page.external, f"the report loads from outside itself: {page.external[:3]}"
+    assert "url(http" not in html and "@import" not in html
+    return html, page, " ".join(page.text)
+
+
+@pytest.fixture(scope="module")
+def demo_dir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("demo")
+    t0 = time.perf_counter()
+    res = demo(d)
+    res["wall"] = time.perf_counter() - t0
+    return d, res
+
+
+def test_the_demo_report_holds_every_section_with_its_numbers(demo_dir):
+    d, res = demo_dir
+    assert res["wall"] < 60  # the issue's budget on a 2-core machine
+    html, page, text = _parse(d / "report.html")
+    for title in ("Ring-down: ringdown_beam.h5", "FRF and modes: hammer_test.h5", "Machine diagnosis: pump_bearing.h5",
+                  "Fleet trends: results.h5", "Provenance"):
+        assert title in text
+    # the synthetic truths: beam 23.7 Hz / zeta 0.012; modes 31, 87, 165 Hz; outer-race fault; pump-3 alarm
+    assert re.search(r"fn 23\.7\d* Hz, zeta 0\.012", text)
+    for f in ("31.0", "87.0", "165.0"):
+        assert f in text.replace("30.99", "31.0").replace("86.99", "87.0")
+    assert "bearing outer race" in text and "pump-3: alarm" in text
+    assert page.tags.count("svg") >= 8  # ring-down, backbone, FRF, stabilisation, diagnosis, fleet trends
+    assert vm.__version__ in text and len(re.findall(r"[0-9a-f]{64}", html)) >= 4  # input hashes
+
+
+def test_a_report_of_each_kind_and_a_bad_file_listed(tmp_path):
+    # fs / fn = 8.3 < 10: flagged resolution_limited, which the report must explain with what to do
+    rec = vm.synth.free_decay(fn=12.0, zeta=0.02, fs=100.0, duration=6.0, snr_db=40, seed=2)
+    vm.write(tmp_path / "decay.csv", rec)
+    (tmp_path / "broken.h5").write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 64)
+    model = tmp_path / "m.toml"
+    model.write_text('type = "sdof"\n[parameters]\nm = "1 kg"\nk = "5684.89 N/m"\nzeta = 0.02\n')  # fn = 12.0 Hz
+    out = vm.report([tmp_path / "decay.csv", tmp_path / "broken.h5"], tmp_path / "r.html", model=model)
+    html, page, text = _parse(out)
+    assert "Ring-down: decay.csv" in text and "Comparison: decay.csv vs m.toml" in text
+    assert "Not analysed:" in text and "broken.h5" in text  # listed with its error, the rest reported
+    assert re.search(r"fn (12|12\.0\d*|11\.9\d*) Hz", text)  # 12.0 Hz to the 5 digits shown
+    assert "resolution_limited" in text and "What to do:" in text and "record longer (finer lines) or sample faster" in text
+
+
+def test_an_empty_store_and_bad_output_paths(tmp_path):
+    with vm.Store(tmp_path / "s.h5", writable=True) as st:
+        st.add_asset("a")
+    out = vm.report([], tmp_path / "r.html", store=tmp_path / "s.h5")
+    _, _, text = _parse(out)
+    assert "no trend yet" in text and "fewer measurements than the baseline needs" in text
+    with pytest.raises(vm.ParameterError, match="folder .* does not exist"):
+        vm.report([], tmp_path / "missing" / "r.html", store=tmp_path / "s.h5")
+    with pytest.raises(vm.ParameterError, match="nothing to report"):
+        vm.report([], tmp_path / "r2.html")
+    assert not (tmp_path / "r2.html").exists()
+
+
+def _chromium():
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        p = shutil.which(name)
+        if p:
+            return p
+    if os.environ.get("VIBMEASURE_CI"):
+        pytest.fail("CI must have Debian's chromium (.ci/run installs it with apt-get)")
+    pytest.skip("no Chromium on this machine (outside CI): the browser test needs Debian's chromium package")
+
+
+def test_the_demo_report_renders_in_a_real_browser(demo_dir, tmp_path):
+    d, _ = demo_dir
+    browser = _chromium()
+    url = (d / "report.html").resolve().as_uri()
+    common = [browser, "--headless=new", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+              "--window-size=412,915", "--virtual-time-budget=5000", "--enable-logging=stderr", "--v=0"]
+    dom = subprocess.run(common + ["--dump-dom", url], capture_output=True, text=True, timeout=120)
+    assert dom.returncode == 0, dom.stderr[-2000:]
+    n_fig = int(re.search(r'data-figures="(\d+)"', dom.stdout).group(1))
+    n_ok = int(re.search(r'data-figures-rendered="(\d+)"', dom.stdout).group(1))
+    assert n_fig >= 8 and n_ok == n_fig  # every picture has a size on a phone-wide page
+    assert "fn 23.7" in dom.stdout and "bearing outer race" in dom.stdout
+    console = [l for l in dom.stderr.splitlines() if "CONSOLE" in l or "Uncaught" in l]
+    assert not console, console  # no console errors (a script error, a resource refused)
+    shot = tmp_path / "report.png"
+    r = subprocess.run(common + [f"--screenshot={shot}", url], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and shot.stat().st_size > 20_000
+
+
+def test_vibmeasure_demo_command(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "vibmeasure.cli", "demo", "--out", str(tmp_path / "d")],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr[-1500:]
+    assert "report:" in r.stdout and (tmp_path / "d" / "report.html").stat().st_size > 100_000
+    assert (tmp_path / "d" / "results.h5").exists()
+    again = subprocess.run([sys.executable, "-m", "vibmeasure.cli", "demo", "--out", str(tmp_path / "d")],
+                           capture_output=True, text=True, timeout=300)  # inputs reused, stored ones skipped
+    assert again.returncode == 0 and "synthesising" not in again.stderr
+    assert np.isfinite(float(re.search(r"done in (\d+) s", again.stdout).group(1)))
