@@ -622,24 +622,11 @@ def main(argv=None, *, out=None, err=None) -> int:
 
 
 def _dispatch(args, out, err) -> int:
-    if args.command == "spectrum":
-        return _main_spectrum(args, out, err)
-    if args.command in ("frf", "modes"):
-        return _main_frf(args, out, err)
-    if args.command == "model":
-        return _main_model(args, out, err)
-    if args.command == "diagnose":
-        return _main_diagnose(args, out, err)
-    if args.command == "compare":
-        return _main_compare(args, out, err)
-    if args.command == "batch":
-        return _main_batch(args, out, err)
-    if args.command == "trend":
-        return _main_trend(args, out, err)
-    if args.command == "demo":
-        return _main_demo(args, out, err)
-    if args.command == "report":
-        return _main_report(args, out, err)
+    handlers = {"spectrum": _main_spectrum, "frf": _main_frf, "modes": _main_frf, "model": _main_model,
+                "diagnose": _main_diagnose, "compare": _main_compare, "batch": _main_batch, "trend": _main_trend,
+                "demo": _main_demo, "report": _main_report}
+    if args.command in handlers:
+        return handlers[args.command](args, out, err)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", QualityWarning)
         try:

@@ -12,7 +12,6 @@ file hashes) closes the report. The HTML comes from a Jinja2 template (templates
 from __future__ import annotations
 
 import datetime as _dt
-import hashlib
 import io as _io
 import platform
 from pathlib import Path
@@ -21,6 +20,7 @@ import numpy as np
 
 from .core.errors import ParameterError, VibMeasureError
 from .core.results import FLAG_TEXT
+from .io._common import file_sha256
 
 __all__ = ["report", "FLAG_ADVICE"]
 
@@ -75,14 +75,6 @@ def _flags(flags) -> list[dict]:
         out.append({"flag": f, "text": FLAG_TEXT.get(f, f),
                     "advice": FLAG_ADVICE.get(f, "see the documentation of the flag")})
     return out
-
-
-def _sha(path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 22), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def _mode_table(est, caption):
@@ -251,7 +243,7 @@ def analyse_input(path, *, rpm=None, bearing=None, band=None, model=None):
                 method += f"; compare with {Path(model).name}"
             except (VibMeasureError, OSError, ValueError) as exc:
                 secs.append(error_section(f"comparison {what}", exc))
-    return secs, {"input": name, "sha256": _sha(path), "method": method}
+    return secs, {"input": name, "sha256": file_sha256(path), "method": method}
 
 
 def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration measurement report", rpm=None,
@@ -279,13 +271,13 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
             prov.append(row)
         except (VibMeasureError, OSError, ValueError) as exc:
             sections.append(error_section(Path(p).name, exc))
-            prov.append({"input": Path(p).name, "sha256": _sha(p) if Path(p).is_file() else "(missing)",
+            prov.append({"input": Path(p).name, "sha256": file_sha256(p) if Path(p).is_file() else "(missing)",
                          "method": "not analysed"})
     if store is not None:
         try:
             sections.append(fleet_section(store, Path(store).name if not hasattr(store, "path") else store.path.name))
             prov.append({"input": Path(store if not hasattr(store, "path") else store.path).name,
-                         "sha256": _sha(store if not hasattr(store, "path") else store.path), "method": "trend"})
+                         "sha256": file_sha256(store if not hasattr(store, "path") else store.path), "method": "trend"})
         except (VibMeasureError, OSError, ValueError) as exc:
             sections.append(error_section(str(store), exc))
     if not sections:

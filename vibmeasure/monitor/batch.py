@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import csv
 import glob
-import hashlib
 import os
 import time as _time
 from pathlib import Path
@@ -21,6 +20,7 @@ import numpy as np
 
 from ..core._threads import one_blas_thread
 from ..core.errors import ParameterError, VibMeasureError
+from ..io._common import file_sha256
 
 __all__ = ["batch", "read_manifest", "analyse_file", "TASKS", "MANIFEST_COLUMNS"]
 
@@ -102,14 +102,6 @@ def _expand(inputs) -> list[dict]:
     return items
 
 
-def _file_sha256(path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 22), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 # --- the work of one input (runs on a worker) ------------------------------------------------------
 def _summary_modes(est) -> dict:
     out = {"n_modes": int(est.n_modes)}
@@ -180,7 +172,7 @@ def analyse_file(item: dict, tasks, options: dict | None = None) -> dict:
         warnings.simplefilter("ignore")
         try:
             import vibmeasure as vm
-            out["sha256"] = _file_sha256(item["file"])
+            out["sha256"] = file_sha256(item["file"])
             rec = vm.read(item["file"], fs=options.get("fs"))
             out["channels"] = [c.name for c in rec.channels]
             out["n_samples"], out["fs"] = int(rec.n_samples), float(rec.fs)
@@ -310,7 +302,7 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
             sha = None
             if not force and known:
                 try:
-                    sha = _file_sha256(it["file"])
+                    sha = file_sha256(it["file"])
                 except OSError as exc:
                     rows.append({"file": it["file"], "status": "error", "measurement": None, "message": str(exc)})
                     continue
