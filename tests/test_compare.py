@@ -94,6 +94,12 @@ def test_cli_model_and_compare(tmp_path):
     out = io.StringIO()
     assert main(["compare", str(p), "--baseline", str(base), "--json"], out=out, err=err) == 0
     assert json.loads(out.getvalue())["verdict"] == "ok"
+    # a structure 10 % softer in stiffness (fn -5 %): alarm, and the exit status says so for scripts
+    soft = vm.write(tmp_path / "soft.csv", vm.synth.free_decay(fn=s.fn * 0.95, zeta=0.015, fs=500.0, duration=20.0,
+                                                             snr_db=40, seed=4))
+    out = io.StringIO()
+    assert main(["compare", str(soft), "--model", str(model), "--json"], out=out, err=io.StringIO()) == 1
+    assert json.loads(out.getvalue())["verdict"] == "alarm"
     err = io.StringIO()
     bad = tmp_path / "bad.toml"
     bad.write_text('type = "sdof"\n[parameters]\nm = 2\n')

@@ -94,7 +94,8 @@ def _parser() -> argparse.ArgumentParser:
 
     cp = sub.add_parser("compare", help="identify a measurement and compare it with a model or a baseline",
                         description="Identify the record (ring-down by default; FRF + fit_modes with --input) "
-                                    "and compare with a model (--model) or a healthy baseline history (--baseline).")
+                                    "and compare with a model (--model) or a healthy baseline history (--baseline). "
+                                    "Exit status: 0 ok or watch, 1 alarm, 2 bad input, 3 a defect of vibmeasure.")
     cp.add_argument("file", help="measurement record")
     ref = cp.add_mutually_exclusive_group(required=True)
     ref.add_argument("--model", help="model.toml")
@@ -369,7 +370,7 @@ def _main_compare(args, out, err) -> int:
                   file=out)
     for m in msgs:
         print(f"vibmeasure: warning: {m}", file=err)
-    return 0
+    return 1 if cmp.verdict == "alarm" else 0  # scripts and monitoring jobs act on the exit status
 
 
 def _get_frf(args):
