@@ -200,3 +200,15 @@ def test_modes_errors(tmp_path):
     assert code == 2 and "'nobody' is not in the file" in err
     code, _, err = run(["modes", str(p), "--input", "hammer", "--impact", "--band", "200", "300"])
     assert code == 2 and "band=" in err
+
+
+def test_every_option_of_every_command_has_help_text():
+    import argparse
+    from vibmeasure.cli import _parser
+    missing = []
+    for a in _parser()._actions:
+        if isinstance(a, argparse._SubParsersAction):
+            for name, sp in a.choices.items():
+                missing += [(name, b.dest) for b in sp._actions
+                            if b.help is None and not isinstance(b, argparse._HelpAction)]
+    assert not missing, missing

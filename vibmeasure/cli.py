@@ -48,7 +48,10 @@ def _parser() -> argparse.ArgumentParser:
                         description="Amplitude-correct spectrum, Welch PSD or squared-envelope spectrum of a "
                                     "record; HDF5 records are streamed from disk.")
     sp.add_argument("file", help="record: .csv .h5 .wav .mat .lvm")
-    sp.add_argument("--kind", choices=("amplitude", "psd", "envelope"), default="amplitude")
+    sp.add_argument("--kind", choices=("amplitude", "psd", "envelope"), default="amplitude",
+                    help="amplitude: peak (or rms) amplitude per line in the channel unit; psd: Welch power spectral "
+                         "density (unit^2/Hz); envelope: squared-envelope spectrum after a band-pass (--band), for "
+                         "bearing fault lines (default amplitude)")
     sp.add_argument("--channel", action="append", help="channel(s) to analyse (default: all; envelope: first)")
     sp.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
     sp.add_argument("--unit", help="unit of the data when the file does not say (m, mm/s, g, m/s^2, ...)")
@@ -70,7 +73,9 @@ def _parser() -> argparse.ArgumentParser:
         q.add_argument("file", help="record (.csv .h5 .wav .mat .lvm .uff) or FRF file (.uff)")
         q.add_argument("--input", default="force", help="input (force) channel name (default: the force channel)")
         q.add_argument("--output", action="append", help="output channel(s) (default: all others)")
-        q.add_argument("--estimator", choices=("H1", "H2", "Hv"), default="H1")
+        q.add_argument("--estimator", choices=("H1", "H2", "Hv"), default="H1",
+                       help="H1 = Sxf/Sff (noise on the output; the default), H2 = Sxx/Sfx (noise on the input), "
+                            "Hv = geometric mean of both (noise on both)")
         q.add_argument("--window", default="hann", help="window for random excitation (default hann)")
         q.add_argument("--nperseg", type=int, help="segment length for random excitation")
         q.add_argument("--impact", action="store_true", help="hammer test: one record per hit, force and "
@@ -121,7 +126,9 @@ def _parser() -> argparse.ArgumentParser:
     dg.add_argument("--gear", type=int, metavar="TEETH", help="teeth of a gear on this shaft")
     dg.add_argument("--line-frequency", type=float, choices=(50.0, 60.0), help="mains frequency: check 2 x line")
     dg.add_argument("--group", type=int, choices=(1, 2), default=2, help="ISO 10816-3 machine group (default 2)")
-    dg.add_argument("--foundation", choices=("rigid", "flexible"), default="rigid")
+    dg.add_argument("--foundation", choices=("rigid", "flexible"), default="rigid",
+                    help="ISO 10816-3 support class: rigid when the machine's lowest support mode is above its "
+                         "running speed, else flexible (default rigid)")
     dg.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
     dg.add_argument("--unit", default=None, help="unit of the data when the file does not say (e.g. g)")
     dg.add_argument("--channel", action="append", help="channel to diagnose; repeat to name several (the first gives "
@@ -150,8 +157,8 @@ def _parser() -> argparse.ArgumentParser:
     tr = sub.add_parser("trend", help="trends, limits and verdicts per asset and point of a store",
                         description="Baseline, watch/alarm limits, trend slope and verdict per metric.")
     tr.add_argument("store", help="the store (.h5)")
-    tr.add_argument("--asset")
-    tr.add_argument("--point")
+    tr.add_argument("--asset", help="only this asset (default: all)")
+    tr.add_argument("--point", help="only this measurement point (default: all)")
     tr.add_argument("--baseline", type=int, default=8, help="measurements in the baseline (default 8)")
     tr.add_argument("--json", action="store_true", help="print one JSON document")
     tr.add_argument("--plot", metavar="OUT.png", help="trend of the worst metric (needs --asset and --point, or "
@@ -172,7 +179,7 @@ def _parser() -> argparse.ArgumentParser:
     rp.add_argument("--bearing", help="catalogue bearing for the diagnosis")
     rp.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"), help="band for ringdown / fit_modes (Hz)")
     rp.add_argument("--model", help="TOML model: each ring-down or modal estimate is compared with it")
-    rp.add_argument("--title", default="Vibration measurement report")
+    rp.add_argument("--title", default="Vibration measurement report", help="the report's title")
     return p
 
 
