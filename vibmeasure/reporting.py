@@ -251,7 +251,6 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
     """Write a self-contained HTML report of ``inputs`` (files) and, with ``store``, the fleet trends;
     returns its path. A file that cannot be analysed is listed with its error and the others are still
     reported. Written atomically: never a half-written report."""
-    import sys
     import jinja2
     import scipy
     from . import __version__
@@ -288,7 +287,6 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
         title=title, version=__version__, created=_dt.datetime.now().strftime("%Y-%m-%d %H:%M"),
         sections=sections, provenance=prov, summary=summary or [], python=platform.python_version(),
         numpy=np.__version__, scipy=scipy.__version__)
-    del sys
     with atomic_path(out) as tmp:
         tmp.write_text(html, encoding="utf-8")
     return out
