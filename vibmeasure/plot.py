@@ -63,7 +63,7 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
         ax.plot(t[sel], offset + env, "--", lw=1.0, color="C3", label="envelope")
         ax.plot(t[sel], offset - env, "--", lw=1.0, color="C3")
         axr.plot(t[sel], x[sel] - model - offset, lw=0.5, color="C2")
-        axr.set_ylabel("residual")
+        axr.set_ylabel(f"residual [{rec.channels[idx].unit or '-'}]")
     else:
         axr.set_visible(False)
     ax.axvline(t0, color="k", lw=0.6, ls=":")
@@ -73,7 +73,8 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
     if est.flags:
         title += "\nflags: " + ", ".join(est.flags)
     ax.set_title(title, fontsize=9)
-    ax.set_ylabel(f"{c.quantity} [{c.unit or '-'}]")
+    what = c.quantity if c.quantity not in ("unknown", "", None) else c.name
+    ax.set_ylabel(f"{what} [{c.unit or '-'}]")
     axr.set_xlabel("time [s]")
     ax.legend(loc="upper right", fontsize=8)
     return ax, axr
@@ -138,10 +139,15 @@ def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
             am.semilogy(frf.freq[sel], np.abs(hs[k]), "--", lw=0.9, label="synthesised (modes only)")
         for f in est.fn:
             am.axvline(f, color="0.6", lw=0.5, ls=":")
-    if frf.coherence is not None:
+    n_avg = frf.params.get("n_averages")
+    if frf.coherence is not None and n_avg != 1:
         ac.plot(frf.freq, frf.coherence[o], lw=0.8, color="C2")
+    else:  # one average: coherence is 1 by construction and says nothing
+        ac.text(0.5, 0.5, "coherence not shown: " + ("one average (it is 1 by construction)" if n_avg == 1
+                                                     else "not measured"),
+                transform=ac.transAxes, ha="center", va="center", fontsize=8, color="0.4")
     ac.set_ylim(0, 1.05)
-    am.set_ylabel(f"|H| {frf.form}")
+    am.set_ylabel(f"|H| {frf.form} [{frf.unit or '-'}]")
     ap.set_ylabel("phase [deg]")
     ac.set_ylabel("coherence")
     ac.set_xlabel("frequency [Hz]")
@@ -160,8 +166,8 @@ def plot_nyquist(frf, *, output=0, input=0, band=None, ax=None):
     h = frf.h[o, i, sel]
     ax.plot(h.real, h.imag, ".-", ms=3, lw=0.6)
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("real")
-    ax.set_ylabel("imaginary")
+    ax.set_xlabel(f"Re H [{frf.unit or '-'}]")
+    ax.set_ylabel(f"Im H [{frf.unit or '-'}]")
     ax.set_title(f"Nyquist: {frf.outputs[o]}/{frf.inputs[i]} ({frf.form})", fontsize=9)
     return ax
 
@@ -185,10 +191,14 @@ def plot_stabilisation(est, *, frf=None, ax=None):
         ax.axvline(f, color="C3", lw=0.8)
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("model order")
+    band = est.extras.get("band_hz")
     if frf is not None:
         ax2 = ax.twinx()
-        ax2.semilogy(frf.freq, np.abs(frf.h).mean(axis=(0, 1)), color="0.3", lw=0.6)
-        ax2.set_ylabel("mean |H|")
+        sel = np.ones(frf.freq.size, bool) if not band else (frf.freq >= band[0]) & (frf.freq <= band[1])
+        ax2.semilogy(frf.freq[sel], np.abs(frf.h[..., sel]).mean(axis=(0, 1)), color="0.3", lw=0.6)
+        ax2.set_ylabel(f"mean |H| [{frf.unit or '-'}]")
+    if band:
+        ax.set_xlim(band[0], band[1])  # the fitted band, not the whole FRF
     ax.legend(loc="upper left", fontsize=8)
     ax.set_title("stabilisation diagram (red: chosen modes)", fontsize=9)
     return ax
@@ -206,6 +216,8 @@ def plot_mac(matrix, *, labels=None, ax=None):
     if labels is not None:
         ax.set_xticks(range(len(labels)), labels)
         ax.set_yticks(range(len(labels)), labels)
+    ax.set_xlabel("mode (second set)")
+    ax.set_ylabel("mode (first set)")
     ax.figure.colorbar(im, ax=ax, fraction=0.046)
     ax.set_title("MAC", fontsize=9)
     return ax
@@ -250,14 +262,18 @@ def plot_diagnosis(rec, diag, *, axes=None):
     for k in range(1, 11):
         ax_s.axvline(k * f1, color="C0", lw=0.5, ls=":")
     ax_s.set_xlabel("frequency [Hz]")
+    ax_s.set_ylabel(f"amplitude [{s.unit or '-'}]")
     ax_s.set_title(f"spectrum of {rec.names[0]} with shaft orders 1X..10X (1X = {f1:.2f} Hz)", fontsize=9)
+    if "speed_inconsistent" in diag.flags or not diag.speed.get("consistent", True):
+        ax_s.text(0.5, 0.9, "WARNING: the speed check failed (see the diagnosis flags)", transform=ax_s.transAxes,
+                  ha="center", color="C3", fontsize=9, fontweight="bold")
     sev = diag.severity
     from .monitor.machinery import ISO_10816_3
     ab, bc, cd = ISO_10816_3[(sev["group"], sev["foundation"])]
     top = cd * 1.5
     for lo, hi, c, z in ((0, ab, "#3a3", "A"), (ab, bc, "#cc3", "B"), (bc, cd, "#e83", "C"), (cd, top, "#d33", "D")):
         ax_g.bar(0, hi - lo, bottom=lo, color=c, width=0.6)
-        ax_g.text(0.35, (lo + hi) / 2, z, va="center")
+        ax_g.text(0.34, (lo + hi) / 2, z, va="center", ha="left", fontsize=8)
     v = sev.get("velocity_rms_mm_s")
     if v is not None:
         ax_g.plot([-0.35, 0.35], [min(v, top)] * 2, color="k", lw=3)
@@ -285,11 +301,14 @@ def _plot_ses(ax, ses, diag, colors):
         ax.axvline(ln["hz"], color=colors.get(fam, "C3"), lw=0.9, ls=style, alpha=0.8)
         if ln["db"] >= 7.8:
             ax.plot(ln["hz"], ln["db"], "v", color=colors.get(fam, "C3"), ms=5)
+    n_lab = 0
     for other, r in tab.iterrows():
         if other.startswith("bearing") and other != fam and np.isfinite(r.expected_hz):
             ax.axvline(r.expected_hz, color=colors.get(other, "0.5"), lw=0.5, ls="--", alpha=0.6)
-            ax.text(r.expected_hz, 0.02, f" {other.split('_', 1)[1]}", transform=ax.get_xaxis_transform(),
-                    rotation=90, fontsize=6, color=colors.get(other, "0.5"))
+            # staggered heights: families whose lines lie close do not print on top of each other
+            ax.text(r.expected_hz, 0.03 + 0.3 * (n_lab % 3), f" {other.split('_', 1)[1]}",
+                    transform=ax.get_xaxis_transform(), rotation=90, fontsize=6, color=colors.get(other, "0.5"))
+            n_lab += 1
     slip = ses.get("slip")
     p = tab.loc[fam, "p_value"]
     f1 = (diag.speed.get("estimated_rpm") or diag.speed["declared_rpm"]) / 60
@@ -299,7 +318,8 @@ def _plot_ses(ax, ses, diag, colors):
                  f"{ses['channel']}); top = {diag.top}\n{fam.split('_', 1)[1]} comb (solid, sidebands dotted) at "
                  f"{f0:.2f} Hz x (1 {(slip if np.isfinite(slip) else 0) * 100:+.2f} % slip), p = {p:.2g}; "
                  "shaft orders faint blue", fontsize=8, loc="left")
-    ax.set_ylabel("dB over floor")
+    ax.set_ylabel("SES [dB over floor]")
+    ax.set_xlabel("frequency [Hz]")
     ax.set_xlim(0, fmax)
 
 
@@ -310,6 +330,7 @@ def _plot_kurtogram(ax, kg, band):
               extent=(0, kg.fs / 2, len(kg.levels) - 0.5, -0.5))
     ax.set_yticks(range(len(kg.levels)), [f"{lv:g}" for lv in kg.levels])
     ax.set_ylabel("level")
+    ax.set_xlabel("frequency [Hz]")
     if band is not None:
         ax.axvspan(band[0], band[1], fill=False, ec="w", lw=1.2)
     lo, hi, lev, val = kg.best("kurtosis")
