@@ -27,6 +27,8 @@ _LAZY = {
     "find_hits": (".identify.frf", "find_hits"),
     "impact_frf": (".identify.frf", "impact_frf"),
     "circle_fit": (".identify.modal", "circle_fit"),
+    "oma_ssi": (".identify.oma", "oma_ssi"),
+    "oma_fdd": (".identify.oma", "oma_fdd"),
     "fit_modes": (".identify.modal", "fit_modes"),
     "mac": (".identify.modal", "mac"),
     "modal_crb": (".identify.modal", "modal_crb"),
@@ -106,7 +108,7 @@ __all__ = [
     "prewhiten", "remove_synchronous", "kurtogram", "band_ses",
     "detrend", "filter", "decimate", "resample", "integrate", "differentiate",
     "ringdown", "ringdown_crb", "estimate_frf", "impact_frf", "find_hits", "fit_modes", "circle_fit", "mac",
-    "modal_crb", "synthesize_frf", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
+    "modal_crb", "synthesize_frf", "oma_ssi", "oma_fdd", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
     "compare", "Comparison", "History", "diagnose", "Diagnosis", "severity_zone", "Bearing", "Gear", "BEARINGS",
     "Store", "StoreLockedError", "batch", "read_manifest", "trend", "report", "models", "synth", "units", "__version__",
 ]

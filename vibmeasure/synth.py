@@ -15,7 +15,7 @@ from .core.errors import ParameterError
 from .core.record import Channel, Record
 from .models.sdof import coulomb_response  # noqa: F401  (public here too: synth.coulomb_response)
 
-__all__ = ["free_decay", "coulomb_decay", "coulomb_response", "noise_std_for_snr", "machine", "fleet"]
+__all__ = ["free_decay", "coulomb_decay", "coulomb_response", "noise_std_for_snr", "machine", "fleet", "ambient"]
 
 _ORDER = {"displacement": 0, "velocity": 1, "acceleration": 2}
 
@@ -383,3 +383,91 @@ def fleet(folder=None, *, n_measurements: int = 52, start: str = "2026-01-05", i
                 w.writeheader()
                 w.writerows(r for r in rows if keep(r))
     return items
+
+
+def ambient(model, *, fs: float, duration: float, outputs=None, inputs=None, quantity: str = "acceleration",
+            noise: float = 0.05, force_std: float = 1.0, seed=None) -> Record:
+    """Response of an MDOF model (``vm.models.MDOF``) to broadband random forces: operational (ambient)
+    vibration with known modes, for output-only modal analysis.
+
+    Independent white Gaussian forces (std ``force_std`` N, held between samples) act at the dofs
+    ``inputs`` (default all); the ``outputs`` dofs (default all) are recorded as ``quantity``. The
+    state-space model is diagonalised and each complex mode discretised exactly for the held force,
+    so the record's discrete poles are exp(lambda / fs) exactly. A warm-up of five time constants of
+    the slowest-decaying mode is simulated and dropped, so the record is stationary from its start.
+    ``outputs`` may also be a matrix (n_sensors, n_dof): each row a sensor reading a combination of
+    dofs (a sensor between two masses, or a second sensor on one dof). ``noise`` is the output noise std as a fraction of each output's RMS (0.05: 5 %).
+    ``meta["truth"]`` holds fn, zeta and the mode shapes at the outputs (the model's ``modes()``).
+    """
+    from scipy.signal import lfilter
+    from .models.mdof import MDOF
+    if not isinstance(model, MDOF):
+        raise ParameterError(f"model must be a vm.models.MDOF, got {type(model).__name__}")
+    fs, duration = positive(fs, "fs"), positive(duration, "duration")
+    noise, force_std = positive(noise, "noise", allow_zero=True), positive(force_std, "force_std")
+    if quantity not in _ORDER:
+        raise ParameterError(f"quantity={quantity!r} must be one of {tuple(_ORDER)}")
+    n = model.n_dof
+    ins = list(range(n)) if inputs is None else [int(i) for i in np.atleast_1d(inputs)]
+    if not ins or any(not 0 <= i < n for i in ins):
+        raise ParameterError(f"inputs={ins} must name dofs 0..{n - 1} of the {n}-dof model")
+    S, names = _sensors(outputs, n)
+    truth = model.modes()
+    if np.any(truth.fn >= fs / 2):
+        raise ParameterError(f"fs={fs:g} Hz: the model's highest mode ({truth.fn.max():.4g} Hz) is above fs/2")
+    if not np.all(truth.zeta > 0):
+        raise ParameterError("the model needs damping (C, rayleigh or modal_zeta): an undamped model never "
+                             "reaches a stationary response")
+    Minv = np.linalg.inv(model.M)
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ model.K, -Minv @ model.C]])
+    B = np.vstack([np.zeros((n, n)), Minv])[:, ins]
+    lam, V = np.linalg.eig(A)
+    G = np.linalg.solve(V, B)                      # modal input matrix (2n, n_in)
+    mu = np.exp(lam / fs)
+    gain = (mu - 1) / lam                          # exact for a force held over one sample
+    n_keep = int(round(fs * duration))
+    n_warm = int(np.ceil(5 / np.min(-lam.real) * fs))
+    rng = np.random.default_rng(seed)
+    F = rng.normal(0.0, force_std, (len(ins), n_warm + n_keep))
+    Z = np.empty((2 * n, F.shape[1]), complex)
+    for r in range(2 * n):
+        # z_r[k] after the force held over samples 0..k-1 (state at sample k)
+        Z[r] = lfilter([0.0, gain[r]], [1.0, -mu[r]], G[r] @ F)
+    X = np.real(V @ Z)
+    disp, vel = X[:n], X[n:]
+    if quantity == "displacement":
+        Y = disp
+    elif quantity == "velocity":
+        Y = vel
+    else:
+        Fd = np.zeros((n, F.shape[1]))
+        Fd[ins] = F
+        Y = Minv @ (Fd - model.C @ vel - model.K @ disp)
+    Y = S @ Y[:, n_warm:]
+    if noise > 0:
+        Y = Y + rng.normal(size=Y.shape) * (noise * np.std(Y, axis=1, keepdims=True))
+    unit = _units.SI_UNIT[quantity]
+    shapes = S @ truth.shapes if truth.shapes is not None else None
+    meta_truth = {"kind": "ambient", "fn": truth.fn.tolist(), "zeta": truth.zeta.tolist(),
+                  "shapes": None if shapes is None else np.real_if_close(shapes).tolist(), "outputs": S.tolist(),
+                  "inputs": ins, "noise": noise, "force_std": force_std, "seed": seed, "quantity": quantity}
+    chans = tuple(Channel(nm, quantity, unit) for nm in names)
+    return Record(Y, fs, chans, meta={"truth": meta_truth}, history=(f"synth ambient {n}-dof",))
+
+
+def _sensors(outputs, n):
+    """Sensor matrix (n_out, n_dof) and channel names from dof indices or a matrix."""
+    if outputs is None:
+        return np.eye(n), [f"dof{i}" for i in range(n)]
+    a = np.asarray(outputs)
+    if a.ndim == 2:
+        S = a.astype(float)
+        if S.shape[1] != n or not np.all(np.isfinite(S)) or not np.all(np.any(S != 0, axis=1)):
+            raise ParameterError(f"outputs as a matrix must be (n_sensors, {n}) with a finite non-zero row per "
+                                 f"sensor, got shape {S.shape}")
+        return S, [f"s{i}" for i in range(S.shape[0])]
+    idx = [int(o) for o in np.atleast_1d(a)]
+    if not idx or any(not 0 <= i < n for i in idx) or len(set(idx)) != len(idx):
+        raise ParameterError(f"outputs={idx} must name distinct dofs 0..{n - 1} of the {n}-dof model (a "
+                             "matrix of sensor rows allows combinations)")
+    return np.eye(n)[idx], [f"dof{i}" for i in idx]

@@ -1,0 +1,653 @@
+"""Output-only (operational) modal analysis: modes from the response to ambient excitation alone.
+
+``oma_ssi``: covariance-driven stochastic subspace identification. The output covariances
+R_i = E[y_{k+i} y_k^T] of a system driven by white noise are C A^(i-1) G, so the block Toeplitz
+matrix of R_1..R_(2s-1) factors into observability times controllability; its SVD gives the
+observability matrix, from which A (poles) and C (mode shapes) follow at every model order. Poles
+that persist across orders (frequency, damping and shape) are clustered into modes; each mode's
+standard deviations come from a block jackknife of the covariance estimate (the record cut into
+``n_blocks`` blocks, the identification repeated with each block left out).
+
+``oma_fdd``: frequency-domain decomposition. The SVD of the output cross-spectral matrix at every
+line separates the modes: near a mode the first singular value is that mode's SDOF bell and its
+singular vector the shape. Peaks are selected by a stated rule; EFDD takes each bell back to a
+free decay (its correlation function) and fits it with the ring-down estimator.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core._threads import single_threaded
+from ..core._validate import check_band, select_names
+from ..core.errors import FitError, ParameterError, warn_quality
+from ..core.record import Record
+from ..core.results import ModalEstimate
+from ._poles import pole_to_modal  # noqa: F401  (kept next to fit_modes' conversion)
+
+__all__ = ["oma_ssi", "oma_fdd", "mpc", "mpd"]
+
+STAB_DF = 0.01        # stable: frequency within 1 % of a pole at the previous order
+STAB_DZ = 0.05        # damping within 5 %
+STAB_MAC = 0.98       # and shape MAC >= 0.98
+CLUSTER_DF = 0.01     # poles within 1 % and
+CLUSTER_MAC = 0.9     # MAC >= 0.9 belong to one mode
+TONE_KURTOSIS = 2.2   # band kurtosis below this: a harmonic (sinusoid: 1.5), not a random response (3)
+MIN_MPC = 0.7         # modal phase collinearity below this: not a real (normal) structural mode
+MAX_ZETA = 0.2        # poles with more damping are noise or numerical
+MAX_REL_ZETA_STD = 0.3  # the limit ringdown and fit_modes use
+MIN_CYCLES = 100      # a mode needs this many cycles in the record for its damping to mean anything
+
+
+# --- shared -------------------------------------------------------------------------------------
+def mpc(phi) -> np.ndarray:
+    """Modal phase collinearity (0..1) of shapes (n_out, n_modes): 1 for a real (normal) mode."""
+    phi = np.atleast_2d(np.asarray(phi, complex).T).T
+    out = []
+    for v in phi.T:
+        sxx, syy, sxy = np.sum(v.real ** 2), np.sum(v.imag ** 2), np.sum(v.real * v.imag)
+        if sxx + syy == 0:
+            out.append(np.nan)
+            continue
+        out.append(((sxx - syy) ** 2 + 4 * sxy ** 2) / (sxx + syy) ** 2)
+    return np.array(out)
+
+
+def mpd(phi) -> np.ndarray:
+    """Mean phase deviation (degrees) of shapes (n_out, n_modes) from their best straight line in the
+    complex plane, weighted by the components' magnitudes: 0 for a real mode."""
+    phi = np.atleast_2d(np.asarray(phi, complex).T).T
+    out = []
+    for v in phi.T:
+        w = np.abs(v)
+        if not w.any():
+            out.append(np.nan)
+            continue
+        _, _, vt = np.linalg.svd(np.c_[v.real, v.imag], full_matrices=False)
+        t = vt[0]
+        den = np.abs(v) * np.hypot(*t)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dev = np.degrees(np.arccos(np.clip(np.abs(v.real * t[0] + v.imag * t[1]) / np.maximum(den, 1e-300),
+                                               0, 1)))
+        out.append(float(np.sum(w * dev) / np.sum(w)))
+    return np.array(out)
+
+
+def _mac(a, b) -> float:
+    return float(np.abs(np.vdot(a, b)) ** 2 / max(np.vdot(a, a).real * np.vdot(b, b).real, 1e-300))
+
+
+def _normalise(phi: np.ndarray) -> np.ndarray:
+    """Scale each shape so its largest component is 1 (real when the mode is real)."""
+    phi = np.array(phi, complex)
+    for j in range(phi.shape[1]):
+        k = int(np.argmax(np.abs(phi[:, j])))
+        phi[:, j] = phi[:, j] / phi[k, j]
+    return phi
+
+
+def _outputs(rec, channels, what: str, min_outputs: int):
+    """The output channels (n_out, n) as float, checked: finite, not constant, enough of them."""
+    if not isinstance(rec, Record):
+        raise ParameterError(f"{what}: rec must be a vm.Record of the measured responses, got {type(rec).__name__}")
+    idx = select_names(rec.names, channels, source="the record")
+    if channels is None:
+        idx = [i for i in idx if rec.channels[i].quantity != "force"]
+    if len(idx) < min_outputs:
+        raise ParameterError(f"{what} needs at least {min_outputs} output channels (a mode shape needs two "
+                             f"points), got {len(idx)} ({[rec.names[i] for i in idx]}); for one channel use "
+                             "vm.oma_fdd or vm.ringdown on a free decay")
+    Y = np.asarray(rec.data[idx], float)
+    bad = ~np.isfinite(Y)
+    if bad.any():
+        i, k = np.argwhere(bad)[0]
+        raise ParameterError(f"{what}: channel {rec.names[idx[i]]!r} has NaN/inf samples (first at t={k / rec.fs:g} "
+                             "s); the rule is finite data: repair or cut the record first")
+    const = [rec.names[i] for i, y in zip(idx, Y) if np.ptp(y) == 0]
+    if const:
+        raise ParameterError(f"{what}: channel(s) {const} are constant: there is no response to analyse")
+    return Y - Y.mean(axis=1, keepdims=True), [rec.names[i] for i in idx]
+
+
+def band_kurtosis(Y, fs, f0, half_width, shape=None) -> float:
+    """Kurtosis of the outputs projected on ``shape`` (default: the first output) and band-passed to
+    f0 +- half_width (FFT mask over the whole record, the ends trimmed): about 3 for a mode's random
+    response (narrow-band Gaussian), 1.5 for a harmonic (a sinusoid). Brincker's harmonic test."""
+    Y = np.atleast_2d(Y)
+    if shape is None:
+        y = Y[0]
+    else:
+        v = np.asarray(shape, complex)
+        v = v * np.exp(-1j * np.angle(np.sum(v ** 2)) / 2)   # rotate to the best real vector
+        y = np.real(v) @ Y
+    n = y.size
+    X = np.fft.rfft(y)
+    f = np.fft.rfftfreq(n, 1 / fs)
+    X[np.abs(f - f0) > half_width] = 0
+    x = np.fft.irfft(X, n)[n // 10: n - n // 10]
+    p2 = np.mean(x ** 2)
+    return float(np.mean(x ** 4) / p2 ** 2) if p2 > 0 else float("nan")
+
+
+def _check_duration(n: int, fs: float, f_lo: float, what: str):
+    need = MIN_CYCLES / f_lo
+    if n / fs < need:
+        raise ParameterError(f"{what}: the record lasts {n / fs:.4g} s; the lowest frequency of interest, "
+                             f"{f_lo:.4g} Hz, needs at least {MIN_CYCLES} cycles: a minimum duration of {need:.4g} s "
+                             f"(1000 cycles, {10 * need:.4g} s, for damping within a few %)")
+
+
+# --- SSI-cov ------------------------------------------------------------------------------------
+def _decimate(Y, fs, band):
+    """Low-pass and decimate so that the band's top sits near 0.4 fs (SSI resolves the band with fewer
+    block rows); the continuous poles are unchanged."""
+    if band is None:
+        return Y, fs, 1
+    q = int(np.floor(0.4 * fs / band[1]))
+    if q < 2:
+        return Y, fs, 1
+    from scipy.signal import resample_poly
+    return resample_poly(Y, 1, q, axis=1), fs / q, q
+
+
+def _covariances(Y, n_lags, n_blocks):
+    """Per block b, sums of y_{k+i} y_k^T over k in the block (i = 0..n_lags) and the counts:
+    (n_blocks, n_lags+1, l, l) and (n_blocks, n_lags+1)."""
+    l, n = Y.shape
+    edges = np.linspace(0, n, n_blocks + 1).astype(int)
+    S = np.zeros((n_blocks, n_lags + 1, l, l))
+    cnt = np.zeros((n_blocks, n_lags + 1))
+    for b in range(n_blocks):
+        k0, k1 = edges[b], edges[b + 1]
+        for i in range(n_lags + 1):
+            k_end = min(k1, n - i)
+            if k_end <= k0:
+                continue
+            S[b, i] = Y[:, k0 + i:k_end + i] @ Y[:, k0:k_end].T
+            cnt[b, i] = k_end - k0
+    return S, cnt
+
+
+def _toeplitz(R, s):
+    """Block Toeplitz matrix of R_1..R_(2s-1): block (i, j) = R_(s + i - j)."""
+    l = R.shape[1]
+    T = np.empty((s * l, s * l))
+    for i in range(s):
+        for j in range(s):
+            T[i * l:(i + 1) * l, j * l:(j + 1) * l] = R[s + i - j]
+    return T
+
+
+def _poles_at(U, sv, order, l, fs, O=None):
+    """Continuous poles (Im > 0) and shapes at one model order from the Toeplitz SVD (or from a given
+    observability matrix O)."""
+    if O is None:
+        O = U[:, :order] * np.sqrt(sv[:order])
+    A = np.linalg.lstsq(O[:-l], O[l:], rcond=None)[0]
+    mu, psi = np.linalg.eig(A)
+    ok = (np.abs(mu) > 0) & (np.abs(mu) < 1) & (mu.imag > 0)
+    lam = np.log(mu[ok]) * fs
+    phi = (O[:l] @ psi[:, ok])
+    return lam, phi
+
+
+def _modal(lam):
+    wn = np.abs(lam)
+    return wn / (2 * np.pi), -lam.real / wn
+
+
+def _stabilisation(U, sv, orders, l, fs, band):
+    """Poles of every order with their status against the previous order: 'o' new, 'f' frequency
+    stable, 'd' also damping, 's' also shape (MAC); the stable ones ('s' with MPC above MIN_MPC)."""
+    table, stable, prev = [], [], None
+    for n in orders:
+        lam, phi = _poles_at(U, sv, n, l, fs)
+        f, z = _modal(lam)
+        keep = (f >= band[0]) & (f <= band[1]) & (z > 0) & (z < MAX_ZETA)
+        lam, phi, f, z = lam[keep], phi[:, keep], f[keep], z[keep]
+        m = mpc(phi) if phi.size else np.array([])
+        for k in range(lam.size):
+            st = "o"
+            if prev is not None and prev[0].size:
+                fp, zp, php = prev
+                j = int(np.argmin(np.abs(fp - f[k])))
+                if abs(fp[j] - f[k]) <= STAB_DF * f[k]:
+                    st = "f"
+                    if abs(zp[j] - z[k]) <= STAB_DZ * z[k]:
+                        st = "d"
+                        if _mac(php[:, j], phi[:, k]) >= STAB_MAC:
+                            st = "s"
+            table.append((n, float(f[k]), float(z[k]), st, float(m[k])))
+            if st == "s" and m[k] >= MIN_MPC:
+                stable.append({"order": n, "lam": lam[k], "f": f[k], "z": z[k], "phi": phi[:, k]})
+        prev = (f, z, phi)
+    return table, stable
+
+
+def _cluster(stable, n_orders):
+    """Group stable poles into modes, from the highest order down: each pole joins the nearest cluster
+    (frequency within CLUSTER_DF, shape MAC >= CLUSTER_MAC) that has no pole of its order yet, else
+    starts one, so two close modes seen at one order stay two. Clusters seen at 20 % of the orders
+    (at least 3) are modes."""
+    clusters = []
+    by_order = {}
+    for p in stable:
+        by_order.setdefault(p["order"], []).append(p)
+    for n in sorted(by_order, reverse=True):
+        pairs = []
+        for i, p in enumerate(by_order[n]):
+            for j, c in enumerate(clusters):
+                df = abs(p["f"] - c["f"]) / c["f"]
+                mac = _mac(p["phi"], c["phi"])
+                if df <= CLUSTER_DF and mac >= CLUSTER_MAC:
+                    pairs.append((df + (1 - mac), i, j))
+        used_p, used_c = set(), set()
+        for _, i, j in sorted(pairs):
+            if i in used_p or j in used_c:
+                continue
+            used_p.add(i)
+            used_c.add(j)
+            c = clusters[j]
+            c["members"].append(by_order[n][i])
+            c["f"] = float(np.median([q["f"] for q in c["members"]]))
+        for i, p in enumerate(by_order[n]):
+            if i not in used_p:
+                clusters.append({"f": p["f"], "phi": p["phi"], "members": [p]})
+    need = max(3, int(np.ceil(0.2 * n_orders)))
+    modes = [c for c in clusters if len(c["members"]) >= need]
+    return sorted(modes, key=lambda c: c["f"]), need
+
+
+def _representative(c):
+    """The member at the cluster's median order (its shape represents the mode) and the cluster's
+    estimate: the mean fn and zeta over its orders (a smooth statistic, so the jackknife applies)."""
+    orders = sorted(q["order"] for q in c["members"])
+    mid = orders[len(orders) // 2]
+    rep = dict(next(q for q in c["members"] if q["order"] == mid))
+    rep["orders"] = orders
+    rep["fn"] = float(np.mean([q["f"] for q in c["members"]]))
+    rep["zeta"] = float(np.mean([q["z"] for q in c["members"]]))
+    return rep
+
+
+def _replicate(T, V, sv, l, fs, reps):
+    """One jackknife replicate: each mode's fn and zeta at every order of its cluster (NaN where the
+    replicate has no pole within CLUSTER_DF and CLUSTER_MAC of it), shape (n_modes, n_orders, 2)."""
+    cache = {}
+    width = max(len(rp["orders"]) for rp in reps)
+    out = np.full((len(reps), width, 2), np.nan)
+    for m, rp in enumerate(reps):
+        for a, n in enumerate(rp["orders"]):
+            if n not in cache:
+                # the replicate's observability matrix on the full data's right singular vectors:
+                # T_b V_n S_n^-1/2 (first-order equal to its own SVD's, without the order swaps of
+                # near-equal singular values that make a re-computed SVD jump)
+                cache[n] = _poles_at(None, None, n, l, fs, O=T @ V[:, :n] / np.sqrt(sv[:n]))
+            lam, phi = cache[n]
+            if not lam.size:
+                continue
+            f, z = _modal(lam)
+            macs = np.array([_mac(phi[:, k], rp["phi"]) for k in range(lam.size)])
+            k = int(np.argmin(np.abs(f - rp["fn"]) / rp["fn"] - macs))
+            if abs(f[k] - rp["fn"]) <= CLUSTER_DF * rp["fn"] and macs[k] >= CLUSTER_MAC:
+                out[m, a] = f[k], z[k]
+    return out
+
+
+def _jackknife(S, cnt, s, l, fs, reps, V, sv):
+    """Block jackknife of the output covariances: the identification repeated with each block left
+    out. At each order of a mode's cluster the jackknife std follows from the replicates' poles
+    (where at least 80 % of them hold the mode); the mode's std is the median over those orders,
+    which an order where the mode is marginal does not move. NaN when no order qualifies."""
+    n_b = S.shape[0]
+    tot, ctot = S.sum(axis=0), cnt.sum(axis=0)
+    vals = []
+    for b in range(n_b):
+        R = (tot - S[b]) / np.maximum(ctot - cnt[b], 1)[:, None, None]
+        vals.append(_replicate(_toeplitz(R, s), V, sv, l, fs, reps))
+    vals = np.array(vals)                       # (n_b, n_modes, n_orders, 2)
+    n_ord = np.array([len(rp["orders"]) for rp in reps])
+    import warnings
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)   # modes a replicate lost: NaN, by design
+        # each replicate's estimate is the mean over the cluster's orders, like the full-data one
+        est = np.nanmean(vals, axis=2)                      # (n_b, n_modes, 2)
+        est[np.isfinite(vals[..., 0]).sum(axis=2) < 0.8 * n_ord] = np.nan
+        found = np.isfinite(est[..., 0]).sum(axis=0)
+        mean = np.nanmean(est, axis=0)
+        out = np.sqrt((n_b - 1) / np.maximum(found, 1)[:, None] * np.nansum((est - mean) ** 2, axis=0))
+        out[found < 0.8 * n_b] = np.nan
+    return out[:, 0], out[:, 1]
+
+
+def _psd_overlay(Y, fs):
+    """Mean auto-PSD of the outputs, for the stabilisation plot."""
+    from scipy.signal import welch
+    nper = int(min(Y.shape[1], 2 ** int(np.log2(max(Y.shape[1] // 8, 64)))))
+    f, P = welch(Y, fs=fs, nperseg=nper)
+    return f, P.mean(axis=0)
+
+
+@single_threaded
+def oma_ssi(rec, *, band=None, max_order: int = 40, block_rows: int | None = None, channels=None,
+            n_blocks: int = 20) -> ModalEstimate:
+    """Modes from output-only data by covariance-driven stochastic subspace identification (SSI-cov).
+
+    ``band`` (Hz) keeps the modes inside it (the record is low-pass decimated so that the band's top
+    sits near 0.4 fs); ``max_order`` is the highest model order of the stabilisation diagram (even
+    orders from 2); ``block_rows`` s sets the covariance lags 1..2s-1 (default: enough for the model
+    order and at least 30). A pole is stable when, against the previous order, its frequency is
+    within 1 %, damping within 5 % and shape MAC >= 0.98, with modal phase collinearity MPC >= 0.7;
+    stable poles within 1 % and MAC >= 0.9 are clustered, and a cluster seen at 20 % of the orders
+    (at least 3) is a mode. fn and zeta are the cluster's medians over its orders; their stds come
+    from a block jackknife of the output covariances (``n_blocks`` blocks; per order, then the
+    median over the cluster's orders). A mode whose damping's relative std exceeds 0.3 is not
+    reported (``extras["rejected_modes"]`` with the reason). Shapes (n_out, n_modes) are complex,
+    scaled to 1 at their largest component; MPC and MPD are in extras.
+    """
+    Y, names = _outputs(rec, channels, "oma_ssi", 2)
+    l = Y.shape[0]
+    band = check_band(band, rec.fs) or (0.0, rec.fs / 2)
+    orders, s, n_blocks = _ssi_sizes(max_order, block_rows, n_blocks, l)
+    if band[0] > 0:
+        _check_duration(Y.shape[1], rec.fs, band[0], "oma_ssi")
+    Yd, fs_d, q = _decimate(Y, rec.fs, band if band[1] < rec.fs / 2 else None)
+    if Yd.shape[1] < 8 * n_blocks * s:
+        # each jackknife block must hold several times the 2 s lags of the covariances
+        raise ParameterError(f"oma_ssi: {Yd.shape[1]} samples (after decimation by {q}) are too few for "
+                             f"block_rows={s} and n_blocks={n_blocks}: at least {8 * n_blocks * s} are needed "
+                             f"(a record of {8 * n_blocks * s * q / rec.fs:.4g} s); record longer or lower them")
+    S, cnt = _covariances(Yd, 2 * s, n_blocks)
+    R = S.sum(axis=0) / cnt.sum(axis=0)[:, None, None]
+    U, sv, Vt = np.linalg.svd(_toeplitz(R, s))
+    table, stable = _stabilisation(U, sv, orders, l, fs_d, band)
+    modes, need = _cluster(stable, len(orders))
+    if not modes:
+        raise FitError(f"oma_ssi: no mode is stable across model orders 2..{orders[-1]} in band={band}: the "
+                       "record holds no resonance there, or too little of it (record longer, or raise max_order)")
+    reps = [_representative(c) for c in modes]
+    fn_std, zeta_std = _jackknife(S, cnt, s, l, fs_d, reps, Vt.T, sv)
+    kurt = [band_kurtosis(Y, rec.fs, rp["fn"], max(3 * rp["zeta"] * rp["fn"], 10 * rec.fs / Y.shape[1]), rp["phi"])
+            for rp in reps]
+    keep, rejected = _screen(reps, fn_std, zeta_std, kurt)
+    if not keep:
+        raise FitError(f"oma_ssi: no mode in band={band} that the data supports: "
+                       + "; ".join(f"{d['fn_hz']:.5g} Hz: {d['reason']}" for d in rejected))
+    return _ssi_estimate(rec, Y, names, [modes[k] for k in keep], [reps[k] for k in keep], fn_std[keep],
+                         zeta_std[keep], table, dict(
+                             block_rows=s, orders=[orders[0], orders[-1]], n_blocks=n_blocks, decimation=q,
+                             min_cluster=need, band_hz=list(band), rejected_modes=rejected))
+
+
+def _screen(reps, fn_std, zeta_std, kurt):
+    """Modes whose damping the blocks reproduce (relative std <= MAX_REL_ZETA_STD, the limit of
+    ringdown and fit_modes) and whose band is a random response, not a harmonic (band kurtosis >=
+    TONE_KURTOSIS); the others are listed with the reason."""
+    keep, rejected = [], []
+    for k, rp in enumerate(reps):
+        rel = zeta_std[k] / rp["zeta"]
+        rp["kurtosis"] = kurt[k]
+        if kurt[k] < TONE_KURTOSIS:
+            why = (f"a harmonic, not a mode: the response in its band has kurtosis {kurt[k]:.2f} (a sinusoid gives "
+                   "1.5, a mode's random response 3)")
+        elif not np.isfinite(rel):
+            why = "lost in more than 20 % of the jackknife replicates: not a stable mode of the data"
+        elif rel > MAX_REL_ZETA_STD:
+            why = f"damping relative std {rel:.2f} > {MAX_REL_ZETA_STD}: the data does not support the mode"
+        else:
+            keep.append(k)
+            continue
+        rejected.append({"fn_hz": rp["fn"], "zeta": rp["zeta"], "fn_std_hz": float(fn_std[k]),
+                         "zeta_std": float(zeta_std[k]), "kurtosis": kurt[k], "reason": why})
+    return keep, rejected
+
+
+def _ssi_sizes(max_order, block_rows, n_blocks, l):
+    if isinstance(max_order, bool) or not isinstance(max_order, (int, np.integer)) or not 4 <= max_order <= 400:
+        raise ParameterError(f"max_order={max_order!r} must be an integer from 4 to 400")
+    s_min = int(np.ceil(max_order / l)) + 1
+    if block_rows is None:
+        s = max(s_min, 30)
+    elif isinstance(block_rows, bool) or not isinstance(block_rows, (int, np.integer)) or block_rows < s_min:
+        raise ParameterError(f"block_rows={block_rows!r} must be an integer >= {s_min}: block_rows x outputs "
+                             f"({l}) must exceed max_order={max_order}")
+    else:
+        s = int(block_rows)
+    if isinstance(n_blocks, bool) or not isinstance(n_blocks, (int, np.integer)) or not 5 <= n_blocks <= 200:
+        raise ParameterError(f"n_blocks={n_blocks!r} must be an integer from 5 to 200")
+    return list(range(2, max_order + 1, 2)), s, int(n_blocks)
+
+
+def _ssi_estimate(rec, Y, names, modes, reps, fn_std, zeta_std, table, info):
+    fn = np.array([rp["fn"] for rp in reps])
+    zeta = np.array([rp["zeta"] for rp in reps])
+    lam = -zeta * 2 * np.pi * fn + 1j * 2 * np.pi * fn * np.sqrt(1 - zeta ** 2)
+    phi = _normalise(np.column_stack([rp["phi"] for rp in reps]))
+    spread_f = [float(np.std([q["f"] for q in c["members"]])) for c in modes]
+    spread_z = [float(np.std([q["z"] for q in c["members"]])) for c in modes]
+    flags = []
+    for k in range(fn.size):
+        fl = []
+        if fn[k] * Y.shape[1] / rec.fs < MIN_CYCLES:
+            fl.append("few_cycles")
+        near = [j for j in range(fn.size) if j != k and abs(fn[j] - fn[k]) < 3 * (zeta[j] * fn[j] + zeta[k] * fn[k])]
+        if near:
+            fl.append("close_modes")
+        flags.append(tuple(fl))
+    f_psd, p_psd = _psd_overlay(Y, rec.fs)
+    extras = dict(info, stabilisation=table, kurtosis=[rp["kurtosis"] for rp in reps], mpc=mpc(phi).tolist(), mpd=mpd(phi).tolist(), outputs=names,
+                  cluster_size=[len(c["members"]) for c in modes], cluster_spread_fn_hz=spread_f,
+                  cluster_spread_zeta=spread_z, model_order=[rp["order"] for rp in reps],
+                  poles=[[float(l.real), float(l.imag)] for l in lam],
+                  std_method=f"block jackknife of the output covariances ({info['n_blocks']} blocks)",
+                  psd={"freq": f_psd, "values": p_psd, "unit": f"({rec.channels[0].unit})^2/Hz"},
+                  criteria={"stable_df": STAB_DF, "stable_dzeta": STAB_DZ, "stable_mac": STAB_MAC,
+                            "min_mpc": MIN_MPC, "cluster_df": CLUSTER_DF, "cluster_mac": CLUSTER_MAC,
+                            "max_zeta": MAX_ZETA})
+    est = ModalEstimate(fn=fn, zeta=zeta, fn_std=fn_std, zeta_std=zeta_std, method="oma_ssi", mode_flags=tuple(flags),
+                        shapes=phi, unit=rec.channels[0].unit, extras=extras)
+    if "few_cycles" in est.flags:
+        warn_quality(f"oma_ssi: mode(s) with fewer than {MIN_CYCLES} cycles in the record: damping is poorly "
+                     "determined; record longer", stacklevel=3)
+    return est
+
+
+# --- FDD / EFDD ---------------------------------------------------------------------------------
+def _csd_matrix(Y, fs, nperseg):
+    """Output cross-spectral matrix G (n_freq, l, l), Hann-windowed segments with 50 % overlap, each
+    zero-padded to 2 nperseg so that the inverse transform of a bell is a linear (not circular)
+    correlation; one-sided PSD units."""
+    l, n = Y.shape
+    w = np.hanning(nperseg + 1)[:-1] if nperseg > 1 else np.ones(1)
+    step = nperseg // 2
+    starts = range(0, n - nperseg + 1, step)
+    nf = nperseg + 1
+    G = np.zeros((nf, l, l), complex)
+    for k0 in starts:
+        X = np.fft.rfft(Y[:, k0:k0 + nperseg] * w, n=2 * nperseg, axis=1)  # (l, nf)
+        G += np.einsum("if,jf->fij", X, X.conj())
+    G *= 2.0 / (fs * np.sum(w ** 2) * len(starts))
+    G[0] /= 2
+    return np.fft.rfftfreq(2 * nperseg, 1 / fs), G, w, len(starts)
+
+
+def _fdd_nperseg(nperseg, n, fs, band):
+    if nperseg is None:
+        nper = 2 ** int(np.log2(max(n // 8, 16)))
+        return int(min(nper, 2 ** 16))
+    if isinstance(nperseg, bool) or not isinstance(nperseg, (int, np.integer)) or not 16 <= nperseg <= n // 2:
+        raise ParameterError(f"nperseg={nperseg!r} must be an integer from 16 to half the record ({n // 2}): "
+                             "the decomposition averages at least 3 segments")
+    return int(nperseg)
+
+
+def _fdd_peaks(f, S, U, sel, min_prom_db, df_seg, n_modes, Y, fs):
+    """Candidate modes: peaks of the first (and second) singular value in the band that stand
+    ``min_prom_db`` above their surroundings (prominence), whose singular vector is coherent around
+    the peak (MAC >= 0.9 with the lines two either side) and whose band is a random response (band
+    kurtosis >= TONE_KURTOSIS; a harmonic or an electrical line gives 1.5)."""
+    from scipy.signal import find_peaks
+    idx = np.flatnonzero(sel)
+    picked, rejected = [], []
+    for j in range(min(2, S.shape[1])):
+        s_db = 10 * np.log10(np.maximum(S[idx, j], 1e-300))
+        pk, props = find_peaks(s_db, prominence=min_prom_db)
+        if not pk.size:
+            continue
+        for p, prom in zip(pk, props["prominences"]):
+            wdt = _half_power_width(s_db, p)
+            i = idx[p]
+            u = U[i, :, j]
+            near = [U[k, :, j] for k in (i - 2, i + 2) if 0 <= k < U.shape[0]]
+            coh = min(_mac(u, v) for v in near) if near else 1.0
+            cand = {"line": int(i), "sv": j, "f": float(f[i]), "prominence_db": float(prom),
+                    "width_bins": float(wdt * (f[1] - f[0]) / df_seg), "coherence_mac": coh}
+            kurt = band_kurtosis(Y, fs, f[i], max(0.5 * wdt * (f[1] - f[0]), 10 * fs / Y.shape[1]), u)
+            cand["kurtosis"] = kurt
+            if kurt < TONE_KURTOSIS:
+                rejected.append(dict(cand, reason=f"a harmonic, not a mode: kurtosis {kurt:.2f} in its band (a "
+                                                  "sinusoid gives 1.5, a mode's random response 3)"))
+            elif coh < 0.9:
+                rejected.append(dict(cand, reason="singular vector not coherent around the peak (MAC < 0.9)"))
+            elif j > 0 and any(abs(c["line"] - i) <= 2 or _mac(U[c["line"], :, c["sv"]], u) >= 0.8 for c in picked):
+                continue  # the second singular value's peak belongs to a mode already found
+            else:
+                picked.append(cand)
+    picked.sort(key=lambda c: -c["prominence_db"])
+    if n_modes is not None:
+        rejected += [dict(c, reason=f"beyond n_modes={n_modes}") for c in picked[n_modes:]]
+        picked = picked[:n_modes]
+    return sorted(picked, key=lambda c: c["f"]), rejected
+
+
+def _half_power_width(s_db, p):
+    """Width (lines, interpolated) of the peak at p where it stays within 3 dB of its top."""
+    lvl = s_db[p] - 3.0
+    lo = p
+    while lo > 0 and s_db[lo - 1] > lvl:
+        lo -= 1
+    hi = p
+    while hi < s_db.size - 1 and s_db[hi + 1] > lvl:
+        hi += 1
+    left = lo - (s_db[lo] - lvl) / (s_db[lo] - s_db[lo - 1]) if lo > 0 else lo
+    right = hi + (s_db[hi] - lvl) / (s_db[hi] - s_db[hi + 1]) if hi < s_db.size - 1 else hi
+    return float(right - left)
+
+
+def _bell(S, U, cand, mac_bell):
+    """The SDOF bell of one mode: at each line the singular value whose vector matches the peak's
+    (MAC >= mac_bell), contiguous from the peak; zero elsewhere."""
+    ref = U[cand["line"], :, cand["sv"]]
+    bell = np.zeros(S.shape[0])
+    lines = []
+    for step in (-1, 1):
+        i = cand["line"] if step == 1 else cand["line"] - 1
+        while 0 <= i < S.shape[0]:
+            macs = [_mac(U[i, :, k], ref) for k in range(S.shape[1])]
+            k = int(np.argmax(macs))
+            if macs[k] < mac_bell:
+                break
+            bell[i] = S[i, k]
+            lines.append(i)
+            i += step
+    return bell, sorted(lines)
+
+
+def _efdd(bell, w, fs, nperseg):
+    """Fit the bell's correlation function (a free decay) with the ring-down estimator."""
+    from .ringdown import ringdown
+    r = np.fft.irfft(bell)[:nperseg]
+    wac = np.correlate(w, w, mode="full")[nperseg - 1:]
+    wac = wac / wac[0]
+    r = r / np.maximum(wac, 1e-12)
+    r0 = r[0]
+    env = np.abs(_analytic(r[: nperseg // 2]))
+    low = np.flatnonzero(env[4:] < 0.1 * r0)
+    end = int(low[0]) + 4 if low.size else nperseg // 2
+    end = max(min(end, int(np.argmax(wac < 0.3)) or nperseg // 2), 64)
+    est = ringdown(Record.from_array(r[:end] / r0, fs=fs, name="correlation"), n_modes=1, start=0.0)
+    return est, end
+
+
+def _analytic(x):
+    from scipy.signal import hilbert
+    return hilbert(x)
+
+
+@single_threaded
+def oma_fdd(rec, *, band, nperseg: int | None = None, channels=None, n_modes: int | None = None,
+            min_prominence_db: float = 6.0, mac_bell: float = 0.8) -> ModalEstimate:
+    """Modes from output-only data by frequency-domain decomposition, damping by EFDD.
+
+    The cross-spectral matrix of the outputs (Hann, 50 % overlap, ``nperseg`` samples per segment)
+    is decomposed by SVD at every line. Peak rule: a peak of the first (or, for close modes, the
+    second) singular value in ``band`` is a mode when it stands ``min_prominence_db`` above its
+    surroundings, its singular vector is coherent around it (MAC >= 0.9 two lines either side) and
+    its band is a random response, not a harmonic (band kurtosis >= 2.2; a sinusoid gives 1.5); ``n_modes`` keeps the most
+    prominent. EFDD: the lines around each peak whose singular vector matches the peak's (MAC >=
+    ``mac_bell``) form the mode's SDOF bell; its inverse transform, corrected for the window, is the
+    mode's correlation function (a free decay), fitted by ``vm.ringdown`` for fn, zeta and their
+    stds. Those stds treat the correlation function's errors as white, which they are not: take them
+    as a lower bound (``oma_ssi`` gives a jackknife std). Shapes are the singular vectors at the peaks.
+    """
+    Y, names = _outputs(rec, channels, "oma_fdd", 1)
+    if band is None:
+        raise ParameterError("oma_fdd: band=(lo, hi) in Hz is required: the range to search for modes")
+    band = check_band(band, rec.fs)
+    if band[0] > 0:
+        _check_duration(Y.shape[1], rec.fs, band[0], "oma_fdd")
+    nper = _fdd_nperseg(nperseg, Y.shape[1], rec.fs, band)
+    if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer))
+                                or n_modes < 1):
+        raise ParameterError(f"n_modes={n_modes!r} must be None or an integer >= 1")
+    if not 0 < float(mac_bell) < 1:
+        raise ParameterError(f"mac_bell={mac_bell!r} must be between 0 and 1")
+    f, G, w, n_seg = _csd_matrix(Y, rec.fs, nper)
+    U, S, _ = np.linalg.svd(G)
+    sel = (f >= band[0]) & (f <= band[1])
+    picked, rejected = _fdd_peaks(f, S, U, sel, float(min_prominence_db), rec.fs / nper, n_modes, Y, rec.fs)
+    if not picked:
+        raise FitError(f"oma_fdd: no peak in band={band} stands {min_prominence_db} dB out of the singular values "
+                       f"as a resonance (rejected: {[(round(c['f'], 3), c['reason']) for c in rejected]})")
+    return _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg)
+
+
+def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg):
+    fn, zeta, fn_std, zeta_std, flags, bells = [], [], [], [], [], []
+    for c in picked:
+        bell, lines = _bell(S, U, c, mac_bell)
+        fl = []
+        try:
+            e, end = _efdd(bell, w, rec.fs, nper)
+            vals = (e.fn[0], e.zeta[0], e.fn_std[0], e.zeta_std[0])
+            fl += [x for x in e.flags if x in ("few_cycles", "low_snr")]
+        except (FitError, ParameterError) as err:
+            vals, end = (c["f"], np.nan, np.nan, np.nan), 0
+            fl.append("efdd_failed")
+            c["efdd_error"] = str(err)
+        if len(lines) < 5:
+            fl.append("resolution_limited")
+        for lst, v in zip((fn, zeta, fn_std, zeta_std), vals):
+            lst.append(float(v))
+        flags.append(tuple(fl))
+        bells.append({"f_lo": float(f[lines[0]]), "f_hi": float(f[lines[-1]]), "n_lines": len(lines),
+                      "decay_samples": int(end), "singular_value": c["sv"] + 1})
+    phi = _normalise(np.column_stack([U[c["line"], :, c["sv"]] for c in picked]))
+    show = (f >= max(0.0, band[0] - 0.1 * (band[1] - band[0]))) & (f <= band[1] + 0.1 * (band[1] - band[0]))
+    extras = {"peaks": picked, "rejected_peaks": rejected, "bells": bells, "band_hz": list(band), "nperseg": nper,
+              "n_segments": n_seg, "outputs": names, "mpc": mpc(phi).tolist(), "mac": np.abs(_mac_matrix(phi)).tolist(),
+              "singular_values": {"freq": f[show], "values": S[show].T, "unit": f"({rec.channels[0].unit})^2/Hz"},
+              "rule": "peaks of the singular values standing min_prominence_db out, coherent singular vector "
+                      "(MAC >= 0.9 over +-2 lines), band kurtosis >= 2.2 (not a harmonic)",
+              "std_method": "ring-down fit of the EFDD correlation function (white-error assumption: a lower "
+                            "bound)"}
+    est = ModalEstimate(fn=fn, zeta=zeta, fn_std=fn_std, zeta_std=zeta_std, method="oma_fdd", mode_flags=tuple(flags),
+                        shapes=phi, unit=rec.channels[0].unit, extras=extras)
+    if "efdd_failed" in est.flags:
+        warn_quality("oma_fdd: EFDD could not fit the decay of some mode(s): their damping is NaN (see "
+                     "extras['peaks'][k]['efdd_error'])", stacklevel=3)
+    return est
+
+
+def _mac_matrix(phi):
+    return np.array([[_mac(a, b) for b in phi.T] for a in phi.T])
