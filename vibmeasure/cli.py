@@ -180,7 +180,133 @@ def _parser() -> argparse.ArgumentParser:
     rp.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"), help="band for ringdown / fit_modes (Hz)")
     rp.add_argument("--model", help="TOML model: each ring-down or modal estimate is compared with it")
     rp.add_argument("--title", default="Vibration measurement report", help="the report's title")
+    sr = sub.add_parser("srs", help="shock response spectrum of a base acceleration record",
+                        description="Shock response spectrum (maximax, primary, residual) by the ramp-invariant "
+                                    "recursive filter (Smallwood); 1/12-octave natural frequencies by default.")
+    sr.add_argument("file", help="record of the base acceleration: .csv .h5 .wav .mat .lvm .uff")
+    sr.add_argument("--channel", help="acceleration channel (default: the first that is not a force)")
+    sr.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
+    sr.add_argument("--unit", help="unit of the acceleration when the file does not say (g, m/s^2)")
+    damp = sr.add_mutually_exclusive_group()
+    damp.add_argument("--zeta", type=float, help="damping ratio of the oscillators (default 0.05)")
+    damp.add_argument("--q", type=float, help="quality factor Q = 1/(2 zeta) (Q 10 is zeta 0.05)")
+    sr.add_argument("--fmin", type=float, help="lowest natural frequency, Hz (default max(fs/16384, 1))")
+    sr.add_argument("--fmax", type=float, help="highest natural frequency, Hz (default fs/4)")
+    sr.add_argument("--octave", type=float, default=1 / 12, help="spacing in octaves (default 1/12)")
+    sr.add_argument("--kind", choices=("maximax", "primary", "residual"), default="maximax",
+                    help="peak response shown first (all three are computed)")
+    sr.add_argument("--output", choices=("acceleration", "pseudo_velocity", "relative_displacement"),
+                    default="acceleration", help="response quantity (default absolute acceleration)")
+    sr.add_argument("--pulse-end", type=float, metavar="SECONDS",
+                    help="end of the pulse: primary before, residual after (default: the record's end)")
+    sr.add_argument("--csv", metavar="OUT.csv", help="write the spectrum as a table")
+    sr.add_argument("--json", action="store_true", help="print one JSON document")
+    sr.add_argument("--plot", metavar="OUT.png", help="write a tripartite (pseudo-velocity) plot")
+
+    om = sub.add_parser("oma", help="output-only modal analysis (SSI-cov or FDD) of ambient responses",
+                        description="Natural frequencies, damping (with std) and shapes from responses to ambient "
+                                    "or operating excitation: covariance-driven SSI (default) or FDD/EFDD.")
+    om.add_argument("file", help="record of the responses: .csv .h5 .wav .mat .lvm .uff")
+    om.add_argument("--method", choices=("ssi", "fdd"), default="ssi",
+                    help="ssi: covariance-driven stochastic subspace identification (default); fdd: frequency-"
+                         "domain decomposition with EFDD damping")
+    om.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"),
+                    help="frequency band (Hz); required for fdd")
+    om.add_argument("--channel", action="append", help="output channel(s) (default: all that are not forces)")
+    om.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
+    om.add_argument("--max-order", type=int, default=40, help="ssi: highest model order (default 40)")
+    om.add_argument("--block-rows", type=int, help="ssi: block rows (covariance lags; default max(30, order))")
+    om.add_argument("--nperseg", type=int, help="fdd: segment length of the cross-spectra")
+    om.add_argument("--json", action="store_true", help="print one JSON document")
+    om.add_argument("--plot", metavar="OUT.png",
+                    help="write the stabilisation diagram (ssi) or the singular values (fdd)")
     return p
+
+
+def _main_srs(args, out, err) -> int:
+    import numpy as np
+    from . import io
+    from .signal.shock import srs
+    rec = io.read(args.file, fs=args.fs, unit=args.unit, quantity="acceleration" if args.unit else None)
+    fn = None
+    if args.fmin is not None or args.fmax is not None:
+        lo = args.fmin if args.fmin is not None else max(rec.fs / 16384, 1.0)
+        hi = args.fmax if args.fmax is not None else rec.fs / 4
+        if not 0 < lo < hi:
+            raise VibMeasureError(f"--fmin {lo:g} and --fmax {hi:g} must satisfy 0 < fmin < fmax")
+        fn = lo * 2 ** (args.octave * np.arange(int(np.floor(np.log2(hi / lo) / args.octave)) + 1))
+    sp = srs(rec, fn=fn, zeta=args.zeta, Q=args.q, kind=args.kind, output=args.output, channel=args.channel,
+             octave=args.octave, pulse_end=args.pulse_end)
+    if args.csv:
+        from .io._common import atomic_path
+        with atomic_path(args.csv) as tmp:
+            sp.to_frame().to_csv(tmp, index=False, float_format="%.10g")
+    if args.json:
+        doc = {"command": "srs", "file": str(args.file), "channel": sp.channel, "output": sp.output, "unit": sp.unit,
+               "zeta": sp.zeta, "q": (1 / (2 * sp.zeta)) if sp.zeta > 0 else None, "input_peak": sp.input_peak,
+               "fn_hz": sp.fn.tolist(), **{k: v.tolist() for k, v in sp.values.items()}}
+        json.dump(doc, out, indent=2, allow_nan=False)
+        out.write("\n")
+    else:
+        k0 = next(iter(sp.values))
+        i = int(np.argmax(sp.values[k0]))
+        print(f"{args.file}: channel {sp.channel}, input peak {sp.input_peak:.4g}, zeta {sp.zeta:g} "
+              f"(Q {1 / (2 * sp.zeta) if sp.zeta > 0 else float('inf'):.3g}); {sp.output} [{sp.unit}]", file=out)
+        print(f"  largest {k0}: {sp.values[k0][i]:.4g} {sp.unit} at {sp.fn[i]:.4g} Hz", file=out)
+        print(f"  {'fn Hz':>10}  " + "  ".join(f"{k:>12}" for k in sp.values), file=out)
+        for j in range(0, sp.fn.size, max(1, sp.fn.size // 24)):
+            print(f"  {sp.fn[j]:10.4g}  " + "  ".join(f"{v[j]:12.4g}" for v in sp.values.values()), file=out)
+    if args.plot:
+        ax = _plot_module().plot_srs(sp)
+        _save_figure(ax.figure, args.plot)
+    for what in ("csv", "plot"):
+        if getattr(args, what):
+            print(f"vibmeasure: wrote {getattr(args, what)}", file=err)
+    return 0
+
+
+def _main_oma(args, out, err) -> int:
+    from . import io
+    from .identify.oma import oma_fdd, oma_ssi
+    rec = io.read(args.file, fs=args.fs, channels=args.channel)
+    band = tuple(args.band) if args.band else None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", QualityWarning)
+        if args.method == "ssi":
+            est = oma_ssi(rec, band=band, max_order=args.max_order, block_rows=args.block_rows)
+        else:
+            if band is None:
+                raise VibMeasureError("--method fdd needs --band LO HI")
+            est = oma_fdd(rec, band=band, nperseg=args.nperseg)
+    msgs = [str(w.message) for w in caught if issubclass(w.category, QualityWarning)]
+    rejected = est.extras.get("rejected_modes" if args.method == "ssi" else "rejected_peaks", [])
+    if args.json:
+        from .core.results import _jsonable
+        doc = {"command": "oma", "file": str(args.file), "fs_hz": rec.fs, **est.to_dict(), "warnings": msgs}
+        doc["extras"] = {k: _jsonable(est.extras[k]) for k in ("band_hz", "outputs", "mpc", "std_method")
+                         if k in est.extras}
+        doc["shapes"] = [[[float(v.real), float(v.imag)] for v in col] for col in est.shapes.T]
+        doc["rejected"] = _jsonable(rejected)
+        json.dump(doc, out, indent=2, allow_nan=False)
+        out.write("\n")
+    else:
+        print(f"{args.file}: {est.method}, {rec.n_channels} outputs, {est.n_modes} mode(s)"
+              f" ({est.extras.get('std_method', '')})", file=out)
+        print(f"{'mode':>4}  {'fn Hz':>12}  {'fn std':>10}  {'zeta':>10}  {'zeta std':>9}  {'MPC':>5}  flags", file=out)
+        for i in range(est.n_modes):
+            print(f"{i + 1:>4}  {est.fn[i]:12.6g}  {est.fn_std[i]:10.2g}  {est.zeta[i]:10.5g}  {est.zeta_std[i]:9.2g}  "
+                  f"{est.extras['mpc'][i]:5.3f}  {','.join(est.mode_flags[i])}", file=out)
+        for r in rejected:
+            f0 = r.get("fn_hz", r.get("f"))
+            print(f"  not a mode: {f0:.6g} Hz: {r['reason']}", file=out)
+    for m in msgs:
+        print(f"vibmeasure: warning: {m}", file=err)
+    if args.plot:
+        pm = _plot_module()
+        ax = pm.plot_stabilisation(est) if args.method == "ssi" else pm.plot_singular_values(est)
+        _save_figure(ax.figure, args.plot)
+        print(f"vibmeasure: wrote {args.plot}", file=err)
+    return 0
 
 
 def _main_demo(args, out, err) -> int:
@@ -632,7 +758,7 @@ def main(argv=None, *, out=None, err=None) -> int:
 def _dispatch(args, out, err) -> int:
     handlers = {"spectrum": _main_spectrum, "frf": _main_frf, "modes": _main_frf, "model": _main_model,
                 "diagnose": _main_diagnose, "compare": _main_compare, "batch": _main_batch, "trend": _main_trend,
-                "demo": _main_demo, "report": _main_report}
+                "demo": _main_demo, "report": _main_report, "srs": _main_srs, "oma": _main_oma}
     if args.command in handlers:
         return handlers[args.command](args, out, err)
     with warnings.catch_warnings(record=True) as caught:

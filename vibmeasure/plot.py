@@ -13,7 +13,7 @@ from .core.errors import ParameterError
 from .core.record import Record
 from .core.results import ModalEstimate
 
-__all__ = ["plot_ringdown", "plot_spectrum", "plot_frf", "plot_nyquist", "plot_stabilisation", "plot_mac", "plot_diagnosis",
+__all__ = ["plot_srs", "plot_singular_values", "plot_transmissibility", "plot_ringdown", "plot_spectrum", "plot_frf", "plot_nyquist", "plot_stabilisation", "plot_mac", "plot_diagnosis",
            "decay_model"]
 
 
@@ -173,18 +173,22 @@ def plot_nyquist(frf, *, output=0, input=0, band=None, ax=None):
 
 
 def plot_stabilisation(est, *, frf=None, ax=None):
-    """The stabilisation diagram of a fit_modes estimate: poles per model order (o new, f stable in
-    frequency, s stable in frequency and damping), the chosen modes, and |H| behind it."""
+    """The stabilisation diagram of a fit_modes or oma_ssi estimate: poles per model order (o new, f
+    stable in frequency, d also damping, s stable in frequency and damping, and for oma_ssi in shape),
+    the chosen modes, and |H| (fit_modes, with ``frf``) or the outputs' mean PSD (oma_ssi) behind it."""
     import matplotlib.pyplot as plt
     if "stabilisation" not in est.extras:
-        raise ParameterError("est must come from vm.fit_modes (it carries the stabilisation table)")
+        raise ParameterError("est must come from vm.fit_modes or vm.oma_ssi (it carries the stabilisation table)")
     if ax is None:
-        _, ax = plt.subplots(figsize=(9, 5))
+        _, ax = plt.subplots(figsize=(9, 5), layout="constrained")
     tab = est.extras["stabilisation"]
+    oma = est.method == "oma_ssi"
     style = {"o": dict(marker="o", color="0.7", ms=3, ls=""), "f": dict(marker="d", color="C1", ms=3, ls=""),
-             "s": dict(marker="x", color="C0", ms=4, ls="")}
-    for key, label in (("o", "new"), ("f", "stable f"), ("s", "stable f, zeta")):
-        pts = [(f, n) for n, f, z, s in tab if s == key]
+             "d": dict(marker="^", color="C2", ms=3, ls=""), "s": dict(marker="x", color="C0", ms=4, ls="")}
+    labels = (("o", "new"), ("f", "stable f"), ("d", "stable f, zeta"), ("s", "stable f, zeta, shape")) if oma \
+        else (("o", "new"), ("f", "stable f"), ("s", "stable f, zeta"))
+    for key, label in labels:
+        pts = [(row[1], row[0]) for row in tab if row[3] == key]
         if pts:
             ax.plot(*zip(*pts), label=label, **style[key])
     for f in est.fn:
@@ -197,6 +201,12 @@ def plot_stabilisation(est, *, frf=None, ax=None):
         sel = np.ones(frf.freq.size, bool) if not band else (frf.freq >= band[0]) & (frf.freq <= band[1])
         ax2.semilogy(frf.freq[sel], np.abs(frf.h[..., sel]).mean(axis=(0, 1)), color="0.3", lw=0.6)
         ax2.set_ylabel(f"mean |H| [{frf.unit or '-'}]")
+    elif oma and "psd" in est.extras:
+        p = est.extras["psd"]
+        ax2 = ax.twinx()
+        sel = np.ones(p["freq"].size, bool) if not band else (p["freq"] >= band[0]) & (p["freq"] <= band[1])
+        ax2.semilogy(p["freq"][sel], p["values"][sel], color="0.3", lw=0.6)
+        ax2.set_ylabel(f"mean PSD [{p['unit']}]")
     if band:
         ax.set_xlim(band[0], band[1])  # the fitted band, not the whole FRF
     ax.legend(loc="upper left", fontsize=8)
@@ -448,4 +458,97 @@ def plot_comparison(cmp, *, rtol_fn: float = 0.02, against: str = "model", ax=No
     ax.set_ylabel("fn deviation [%]")
     ax.set_xlabel("predicted mode")
     ax.set_title(f"measured vs {against}: {cmp.verdict}", fontsize=9)
+    return ax
+
+
+def plot_srs(spec, *, ax=None, tripartite: bool | None = None):
+    """Shock response spectrum on log axes. For pseudo-velocity output (or ``tripartite=True`` with
+    any output) the tripartite grid: pseudo-velocity against frequency, with lines of constant
+    relative displacement (falling) and constant pseudo-acceleration (rising)."""
+    import matplotlib.pyplot as plt
+    if ax is None:
+        _, ax = plt.subplots(figsize=(7, 5.5), layout="constrained")
+    tri = spec.output == "pseudo_velocity" if tripartite is None else bool(tripartite)
+    w = 2 * np.pi * spec.fn
+    span = []
+    for k, v in spec.values.items():
+        y = v
+        if tri and spec.output == "acceleration":
+            from .core import units
+            y = units.convert(v, spec.unit, "m/s^2") / w if spec.unit else v / w
+        elif tri and spec.output == "relative_displacement":
+            y = v * w
+        ax.loglog(spec.fn, y, lw=1.6 if k == "maximax" else 1.0, label=k)
+        if k == "maximax":
+            span = [float(np.min(y[y > 0])) / 3 if np.any(y > 0) else 1e-12, float(np.max(y)) * 3]
+    if span:   # a residual that decayed to nothing would stretch the axis over hundreds of decades
+        ax.set_ylim(*span)
+    ax.set_xlabel("natural frequency [Hz]")
+    q = f"Q {1 / (2 * spec.zeta):.3g}" if spec.zeta > 0 else "undamped"
+    if tri:
+        ax.set_ylabel("pseudo-velocity [m/s]")
+        lo, hi = ax.get_ylim()
+        f0, f1 = spec.fn[0], spec.fn[-1]
+        for d in 10.0 ** np.arange(-9, 2):
+            ax.loglog([f0, f1], [2 * np.pi * f0 * d, 2 * np.pi * f1 * d], color="0.85", lw=0.5, zorder=0)
+        for a in 10.0 ** np.arange(-3, 7):
+            ax.loglog([f0, f1], [a / (2 * np.pi * f0), a / (2 * np.pi * f1)], color="0.85", lw=0.5, ls="--", zorder=0)
+        ax.set_ylim(lo, hi)
+        ax.set_title(f"shock response spectrum, tripartite ({q}; grey: constant displacement m, dashed: constant "
+                     "acceleration m/s^2)", fontsize=8)
+    else:
+        qty = {"acceleration": "peak acceleration", "relative_displacement": "peak relative displacement"}
+        ax.set_ylabel(f"{qty.get(spec.output, spec.output)} [{spec.unit}]")
+        ax.set_title(f"shock response spectrum of {spec.channel} ({q})", fontsize=9)
+    ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=8, loc="lower right")
+    return ax
+
+
+def plot_singular_values(est, *, ax=None, n: int | None = None):
+    """Singular values of the output cross-spectral matrix (oma_fdd), in dB, with the selected modes
+    and their EFDD bells marked."""
+    import matplotlib.pyplot as plt
+    if "singular_values" not in est.extras:
+        raise ParameterError("est must come from vm.oma_fdd (it carries the singular values)")
+    if ax is None:
+        _, ax = plt.subplots(figsize=(9, 4.5), layout="constrained")
+    sv = est.extras["singular_values"]
+    vals = np.asarray(sv["values"])
+    for j in range(vals.shape[0] if n is None else min(n, vals.shape[0])):
+        ax.plot(sv["freq"], 10 * np.log10(np.maximum(vals[j], 1e-300)), lw=0.9 if j == 0 else 0.6, label=f"s{j + 1}")
+    for f, b in zip(est.fn, est.extras["bells"]):
+        ax.axvspan(b["f_lo"], b["f_hi"], color="C3", alpha=0.08)
+        ax.axvline(f, color="C3", lw=0.8)
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel(f"singular value [dB re 1 {sv['unit']}]")
+    ax.set_title("frequency-domain decomposition (red: modes, shaded: EFDD bells)", fontsize=9)
+    ax.legend(fontsize=8, loc="upper right")
+    return ax
+
+
+def plot_transmissibility(tr, *, ax=None):
+    """Measured |T| (and the model's, where given) on log axes, coherence below, the isolation
+    region (|T| < 1) shaded."""
+    import matplotlib.pyplot as plt
+    if ax is None:
+        fig, (ax, axc) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, height_ratios=(3, 1), layout="constrained")
+    else:
+        axc = None
+    ax.loglog(tr.freq, tr.magnitude, lw=1.0, label=f"measured {tr.top}/{tr.base}")
+    if tr.model is not None:
+        ax.loglog(tr.freq, tr.model, "k--", lw=0.9, label="model")
+    ax.axhline(1.0, color="0.5", lw=0.6)
+    iso = tr.isolation_hz
+    if np.isfinite(iso):
+        ax.axvspan(iso, tr.freq[-1], color="C2", alpha=0.08, label=f"isolation above {iso:.3g} Hz")
+    ax.set_ylabel("transmissibility |T| [-]")
+    ax.legend(fontsize=8)
+    if axc is not None:
+        axc.semilogx(tr.freq, tr.coherence, lw=0.8)
+        axc.set_ylim(0, 1.05)
+        axc.set_ylabel("coherence [-]")
+        axc.set_xlabel("frequency [Hz]")
+    else:
+        ax.set_xlabel("frequency [Hz]")
     return ax
