@@ -240,3 +240,30 @@ def test_chowdhury_spectrum_peaks_and_resolution(shared_data):
             assert "lines" in str(exc)
         except vm.QualityWarning:
             pass
+
+
+def test_poly_reference_one_set_of_poles():
+    # two inputs (a MIMO test), 3 modes of which two are 5 % apart: input="all" gives one set of poles,
+    # at least as precise as either input alone (it uses all FRFs), shapes MAC > 0.999 with the truth
+    import warnings
+    fn = np.array([20.0, 21.0, 35.0])
+    z = np.array([0.01, 0.012, 0.015])
+    phi = np.array([[1, 0.8, 0.3], [0.9, -1, 0.6], [0.2, 0.7, -1], [0.5, 0.3, 0.9]])
+    f = np.arange(0, 60, 0.05)
+    h = np.stack([vm.synth.modal_frf(f, fn=fn, zeta=z, shapes=phi, input_dof=q).h[:, 0, :] for q in (0, 2)], axis=1)
+    rng = np.random.default_rng(0)
+    h = h + (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)) * 0.01 * np.abs(h).mean()
+    frf = vm.FRF(f, h, "receptance", outputs=("o0", "o1", "o2", "o3"), inputs=("o0", "o2"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        single = [vm.fit_modes(frf, band=(10, 50), input=k) for k in (0, 1)]
+        both = vm.fit_modes(frf, band=(10, 50), input="all")
+    np.testing.assert_allclose(both.fn, fn, rtol=1e-4)
+    np.testing.assert_allclose(both.zeta, z, rtol=0.05)
+    assert np.all(both.zeta_std <= np.minimum(single[0].zeta_std, single[1].zeta_std) * 1.05)
+    assert np.all(np.diag(np.abs(vm.mac(phi, both.shapes))) > 0.999)
+    part = np.array(both.extras["participation"])
+    assert part.shape == (2, 3) and part[1, 0] == pytest.approx(0.2, abs=0.02)   # phi[2,0] / phi[0,0]
+    assert len(both.extras["rows"]) == 8
+    with pytest.raises(vm.ParameterError, match="distinct inputs"):
+        vm.fit_modes(frf, band=(10, 50), input=["o0", "o0"])

@@ -39,9 +39,17 @@ def _band_lines(frf: FRF, band, inp):
         raise ParameterError(f"band={band!r} must have lo < hi")
     if hi > frf.freq[-1] + 1e-9 or lo < frf.freq[0] - 1e-9:
         raise ParameterError(f"band={band!r} lies outside the FRF's {frf.freq[0]:g}..{frf.freq[-1]:g} Hz")
-    ii = name_index(frf.inputs, inp, what="input")
+    if isinstance(inp, str) and inp == "all":
+        ii = list(range(frf.n_inputs))
+    elif isinstance(inp, (list, tuple)):
+        ii = [name_index(frf.inputs, x, what="input") for x in inp]
+        if not ii or len(set(ii)) != len(ii):
+            raise ParameterError(f"input={inp!r} must name distinct inputs of {list(frf.inputs)}")
+    else:
+        ii = name_index(frf.inputs, inp, what="input")
     sel = (frf.freq >= lo) & (frf.freq <= hi) & (frf.freq > 0)
-    H = frf.h[:, ii, sel]
+    # several inputs (poly-reference): every (output, input) FRF is a row sharing the poles
+    H = frf.h[:, ii, sel] if isinstance(ii, int) else frf.h[:, ii, :][:, :, sel].reshape(-1, int(sel.sum()))
     bad = ~np.isfinite(H).all(axis=0)
     if bad.any():
         raise ParameterError(f"the FRF has {int(bad.sum())} NaN/inf line(s) in band={band!r} (first at "
@@ -390,6 +398,13 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
     residues, the stabilisation table, the synthesised FRFs' correlation (FRAC) and the mode shapes
     are in ``shapes`` (n_outputs, n_modes), unit-normalised (mass-normalised when an output is the
     driving point).
+
+    Poly-reference: ``input="all"`` (or a list of inputs) fits the FRFs of every input column at
+    once, so a MIMO test gives one set of poles; each (output, input) FRF is a row of one common-
+    denominator model (``extras["rows"]``). Each mode's shape comes from the input that excites it
+    most (``extras["reference_input"]``); ``extras["participation"]`` (n_inputs, n_modes) is each
+    input's share. A common denominator does not separate a repeated root (two modes at one
+    frequency); modes a few half-power bandwidths apart are separated.
     """
     f, H, ii, band = _band_lines(frf, band, input)
     if isinstance(max_order, bool) or not isinstance(max_order, (int, np.integer)) or not 4 <= max_order <= 200:
@@ -477,9 +492,22 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
     keep = [keep[i] for i in order]
     flags_mode = [flags_mode[i] for i in order]
     keep = np.array(keep)
-    shapes = R[:, keep].copy()
-    dp = [o for o, name in enumerate(frf.outputs) if name == frf.inputs[ii]]
+    multi = not isinstance(ii, int)
+    if multi:
+        # poly-reference: residues (n_out, n_in, m); each mode's shape from the input that excites it
+        # most, and each input's participation (its residue column's size, relative to the largest)
+        Rm = R.reshape(frf.n_outputs, len(ii), m)
+        size = np.linalg.norm(Rm, axis=0)                       # (n_in, m)
+        ref = np.argmax(size, axis=0)
+        R_ref = np.stack([Rm[:, ref[k], k] for k in range(m)], axis=1)
+        participation = size / np.maximum(size.max(axis=0, keepdims=True), 1e-300)
+        shapes = R_ref[:, keep].copy()
+        dp_input = [frf.inputs[ii[ref[k]]] for k in keep]
+    else:
+        shapes = R[:, keep].copy()
+        dp_input = [frf.inputs[ii]] * keep.size
     for j in range(keep.size):
+        dp = [o for o, name in enumerate(frf.outputs) if name == dp_input[j]]
         col = shapes[:, j]
         if dp and abs(col[dp[0]]) > 0:
             # receptance residue R_pq = phi_p phi_q / (2 i wd): phi = R_pq / sqrt(R_qq 2 i wd)... normalised
@@ -498,7 +526,12 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
               "exp_window_added_zeta": [float(1 / (tau * wn[k])) for k in keep] if tau else None,
               "dropped_poles": dropped, "rejected_modes": rejected,
               "mode_test": {"false_alarm_rate": FALSE_ALARM, "max_rel_zeta_std": MAX_REL_ZETA_STD_FRF},
-              "outputs": list(frf.outputs), "input": frf.inputs[ii], "form": frf.form}
+              "outputs": list(frf.outputs), "form": frf.form,
+              "input": [frf.inputs[i] for i in ii] if multi else frf.inputs[ii]}
+    if multi:
+        extras["participation"] = participation[:, keep].tolist()
+        extras["reference_input"] = dp_input
+        extras["rows"] = [f"{o}/{frf.inputs[i]}" for o in frf.outputs for i in ii]
     est = ModalEstimate(fn=fn[keep], zeta=zeta[keep], fn_std=fn_std[keep], zeta_std=zeta_std[keep],
                         method="fit_modes", mode_flags=tuple(flags_mode), shapes=shapes, extras=extras)
     warn = [fl for fl in est.flags if fl in ("resolution_limited", "low_coherence")]
