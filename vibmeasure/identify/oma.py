@@ -32,6 +32,7 @@ STAB_DZ = 0.05        # damping within 5 %
 STAB_MAC = 0.98       # and shape MAC >= 0.98
 CLUSTER_DF = 0.01     # poles within 1 % and
 CLUSTER_MAC = 0.9     # MAC >= 0.9 belong to one mode
+N_GROUPS = 8          # EFDD jackknife: the segments in this many groups, each left out once
 TONE_KURTOSIS = 2.2   # band kurtosis below this: a harmonic (sinusoid: 1.5), not a random response (3)
 MIN_MPC = 0.7         # modal phase collinearity below this: not a real (normal) structural mode
 MAX_ZETA = 0.2        # poles with more damping are noise or numerical
@@ -462,13 +463,17 @@ def _csd_matrix(Y, fs, nperseg):
     step = nperseg // 2
     starts = range(0, n - nperseg + 1, step)
     nf = nperseg + 1
-    G = np.zeros((nf, l, l), complex)
-    for k0 in starts:
+    n_seg = len(starts)
+    n_g = N_GROUPS if n_seg >= 2 * N_GROUPS and nf * l * l * 16 * N_GROUPS < 5e8 else 0
+    Gg = np.zeros((max(n_g, 1), nf, l, l), complex)
+    for j, k0 in enumerate(starts):
         X = np.fft.rfft(Y[:, k0:k0 + nperseg] * w, n=2 * nperseg, axis=1)  # (l, nf)
-        G += np.einsum("if,jf->fij", X, X.conj())
-    G *= 2.0 / (fs * np.sum(w ** 2) * len(starts))
-    G[0] /= 2
-    return np.fft.rfftfreq(2 * nperseg, 1 / fs), G, w, len(starts)
+        Gg[j * n_g // n_seg if n_g else 0] += np.einsum("if,jf->fij", X, X.conj())
+    scale = 2.0 / (fs * np.sum(w ** 2) * n_seg)
+    Gg *= scale
+    Gg[:, 0] /= 2
+    G = Gg.sum(axis=0)
+    return np.fft.rfftfreq(2 * nperseg, 1 / fs), G, w, n_seg, (Gg if n_g else None)
 
 
 def _fdd_nperseg(nperseg, n, fs, band):
@@ -587,12 +592,14 @@ def oma_fdd(rec, *, band, nperseg: int | None = None, channels=None, n_modes: in
     is decomposed by SVD at every line. Peak rule: a peak of the first (or, for close modes, the
     second) singular value in ``band`` is a mode when it stands ``min_prominence_db`` above its
     surroundings, its singular vector is coherent around it (MAC >= 0.9 two lines either side) and
-    its band is a random response, not a harmonic (band kurtosis >= 2.2; a sinusoid gives 1.5); ``n_modes`` keeps the most
-    prominent. EFDD: the lines around each peak whose singular vector matches the peak's (MAC >=
+    its band is a random response, not a harmonic (band kurtosis >= 2.2; a sinusoid gives 1.5);
+    ``n_modes`` keeps the most prominent. EFDD: the lines around each peak whose singular vector matches the peak's (MAC >=
     ``mac_bell``) form the mode's SDOF bell; its inverse transform, corrected for the window, is the
-    mode's correlation function (a free decay), fitted by ``vm.ringdown`` for fn, zeta and their
-    stds. Those stds treat the correlation function's errors as white, which they are not: take them
-    as a lower bound (``oma_ssi`` gives a jackknife std). Shapes are the singular vectors at the peaks.
+    mode's correlation function (a free decay), fitted by ``vm.ringdown`` for fn and zeta. Their
+    stds come from a jackknife over 8 groups of segments (each left out, the decomposition and EFDD
+    repeated; the ring-down fit's own std where larger), or the ring-down fit's std alone (a lower
+    bound: it takes the correlation function's errors as white) when the record has fewer than 16
+    segments. Shapes are the singular vectors at the peaks.
     """
     Y, names = _outputs(rec, channels, "oma_fdd", 1)
     if band is None:
@@ -606,24 +613,51 @@ def oma_fdd(rec, *, band, nperseg: int | None = None, channels=None, n_modes: in
         raise ParameterError(f"n_modes={n_modes!r} must be None or an integer >= 1")
     if not 0 < float(mac_bell) < 1:
         raise ParameterError(f"mac_bell={mac_bell!r} must be between 0 and 1")
-    f, G, w, n_seg = _csd_matrix(Y, rec.fs, nper)
+    f, G, w, n_seg, Gg = _csd_matrix(Y, rec.fs, nper)
     U, S, _ = np.linalg.svd(G)
     sel = (f >= band[0]) & (f <= band[1])
     picked, rejected = _fdd_peaks(f, S, U, sel, float(min_prominence_db), rec.fs / nper, n_modes, Y, rec.fs)
     if not picked:
         raise FitError(f"oma_fdd: no peak in band={band} stands {min_prominence_db} dB out of the singular values "
                        f"as a resonance (rejected: {[(round(c['f'], 3), c['reason']) for c in rejected]})")
-    return _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg)
+    return _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg, Gg)
 
 
-def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg):
+def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper):
+    """Leave-one-group-out EFDD of one mode (the segments in N_GROUPS groups): jackknife std of fn
+    and zeta, or None when fewer than all but one replicate succeed."""
+    lo, hi = max(lines[0] - 5, 0), min(lines[-1] + 6, Gg.shape[1])
+    tot = Gg[:, lo:hi].sum(axis=0)
+    ref = U[c["line"], :, c["sv"]]
+    vals = []
+    for g in range(Gg.shape[0]):
+        Ur, Sr, _ = np.linalg.svd(tot - Gg[g, lo:hi])
+        k = int(np.argmax([_mac(Ur[c["line"] - lo, :, j], ref) for j in range(Sr.shape[1])]))
+        sub, sub_lines = _bell(Sr, Ur, dict(c, line=c["line"] - lo, sv=k), mac_bell)
+        bell = np.zeros(Gg.shape[1])
+        bell[lo:hi] = sub
+        try:
+            e, _ = _efdd(bell, w, fs, nper)
+            vals.append((e.fn[0], e.zeta[0]))
+        except (FitError, ParameterError):
+            continue
+    n = Gg.shape[0]
+    if len(vals) < n - 1:
+        return None
+    v = np.array(vals)
+    return np.sqrt((n - 1) / len(v) * np.sum((v - v.mean(axis=0)) ** 2, axis=0))
+
+
+def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg, Gg):
     fn, zeta, fn_std, zeta_std, flags, bells = [], [], [], [], [], []
     for c in picked:
         bell, lines = _bell(S, U, c, mac_bell)
         fl = []
         try:
             e, end = _efdd(bell, w, rec.fs, nper)
-            vals = (e.fn[0], e.zeta[0], e.fn_std[0], e.zeta_std[0])
+            jk = _efdd_jackknife(Gg, c, lines, U, mac_bell, w, rec.fs, nper) if Gg is not None else None
+            stds = (e.fn_std[0], e.zeta_std[0]) if jk is None else (max(jk[0], e.fn_std[0]), max(jk[1], e.zeta_std[0]))
+            vals = (e.fn[0], e.zeta[0], *stds)
             fl += [x for x in e.flags if x in ("few_cycles", "low_snr")]
         except (FitError, ParameterError) as err:
             vals, end = (c["f"], np.nan, np.nan, np.nan), 0
@@ -643,8 +677,9 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
               "singular_values": {"freq": f[show], "values": S[show].T, "unit": f"({rec.channels[0].unit})^2/Hz"},
               "rule": "peaks of the singular values standing min_prominence_db out, coherent singular vector "
                       "(MAC >= 0.9 over +-2 lines), band kurtosis >= 2.2 (not a harmonic)",
-              "std_method": "ring-down fit of the EFDD correlation function (white-error assumption: a lower "
-                            "bound)"}
+              "std_method": f"jackknife over {N_GROUPS} groups of segments (each left out, EFDD repeated); the "
+                            "ring-down fit's own std where larger" if Gg is not None else
+                            "ring-down fit of the EFDD correlation function (white-error assumption: a lower bound)"}
     est = ModalEstimate(fn=fn, zeta=zeta, fn_std=fn_std, zeta_std=zeta_std, method="oma_fdd", mode_flags=tuple(flags),
                         shapes=phi, unit=rec.channels[0].unit, extras=extras)
     if "efdd_failed" in est.flags:
