@@ -23,7 +23,6 @@ from ..core._validate import check_band, select_names
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.record import Record
 from ..core.results import ModalEstimate
-from ._poles import pole_to_modal  # noqa: F401  (kept next to fit_modes' conversion)
 
 __all__ = ["oma_ssi", "oma_fdd", "mpc", "mpd"]
 
