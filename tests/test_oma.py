@@ -154,6 +154,25 @@ def test_bad_input():
         vm.oma_fdd(rec.replace(data=bad), band=(1, 80))
     with pytest.raises(vm.ParameterError, match="MDOF"):
         vm.synth.ambient("not a model", fs=100.0, duration=10.0)
+    with pytest.raises(vm.ParameterError, match="min_prominence_db"):
+        vm.oma_fdd(rec, band=(2, 80), min_prominence_db="x")
+    with pytest.raises(vm.ParameterError, match="mac_bell"):
+        vm.oma_fdd(rec, band=(2, 80), mac_bell=1.5)
+    with pytest.raises(vm.ParameterError, match="samples"):
+        vm.oma_ssi(vm.Record(np.zeros((2, 0)), 100.0))
+
+
+def test_plots_have_units(chain):
+    import matplotlib
+    matplotlib.use("Agg")
+    from vibmeasure.plot import plot_singular_values, plot_stabilisation
+    truth, sensors, rec = chain
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        ax = plot_singular_values(vm.oma_fdd(rec, band=(1, 80)))
+    assert ax.get_xlabel() == "frequency [Hz]" and "m/s^2" in ax.get_ylabel()
+    ax = plot_stabilisation(vm.oma_ssi(rec, band=(1, 80)))
+    assert ax.get_ylabel() == "model order" and "PSD" in ax.figure.axes[-1].get_ylabel()
 
 
 def test_cli_oma(tmp_path):

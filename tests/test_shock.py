@@ -136,6 +136,15 @@ def test_transmissibility_equals_model():
     assert tr.extras["model_isolation_hz"] == pytest.approx(np.sqrt(2) * 10)
     with pytest.raises(vm.ParameterError, match="same channel"):
         vm.transmissibility(rec, base="base", top="base")
+    with pytest.raises(vm.ParameterError, match="nperseg"):
+        vm.transmissibility(rec, base="base", top="top", nperseg="x")
+    with pytest.raises(vm.ParameterError, match="min_coherence"):
+        vm.transmissibility(rec, base="base", top="top", min_coherence=2)
+    import matplotlib
+    matplotlib.use("Agg")
+    from vibmeasure.plot import plot_transmissibility
+    ax = plot_transmissibility(tr)
+    assert "|T|" in ax.get_ylabel() and ax.figure.axes[-1].get_xlabel() == "frequency [Hz]"
 
 
 def test_cli_srs(tmp_path):

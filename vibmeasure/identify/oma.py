@@ -98,6 +98,8 @@ def _outputs(rec, channels, what: str, min_outputs: int):
                              f"points), got {len(idx)} ({[rec.names[i] for i in idx]}); for one channel use "
                              "vm.oma_fdd or vm.ringdown on a free decay")
     Y = np.asarray(rec.data[idx], float)
+    if Y.shape[1] < 16:
+        raise ParameterError(f"{what}: the record has {Y.shape[1]} samples; ambient responses need thousands")
     bad = ~np.isfinite(Y)
     if bad.any():
         i, k = np.argwhere(bad)[0]
@@ -475,7 +477,7 @@ def _csd_matrix(Y, fs, nperseg):
     return np.fft.rfftfreq(2 * nperseg, 1 / fs), G, w, n_seg, (Gg if n_g else None)
 
 
-def _fdd_nperseg(nperseg, n, fs, band):
+def _fdd_nperseg(nperseg, n):
     if nperseg is None:
         nper = 2 ** int(np.log2(max(n // 8, 16)))
         return int(min(nper, 2 ** 16))
@@ -601,16 +603,23 @@ def oma_fdd(rec, *, band, nperseg: int | None = None, channels=None, n_modes: in
     segments. Shapes are the singular vectors at the peaks.
     """
     Y, names = _outputs(rec, channels, "oma_fdd", 1)
+    try:
+        min_prominence_db, mac_bell = float(min_prominence_db), float(mac_bell)
+    except (TypeError, ValueError):
+        raise ParameterError(f"min_prominence_db={min_prominence_db!r} and mac_bell={mac_bell!r} must be numbers") \
+            from None
+    if not (np.isfinite(min_prominence_db) and min_prominence_db > 0):
+        raise ParameterError(f"min_prominence_db={min_prominence_db!r} must be a positive number of dB")
     if band is None:
         raise ParameterError("oma_fdd: band=(lo, hi) in Hz is required: the range to search for modes")
     band = check_band(band, rec.fs)
     if band[0] > 0:
         _check_duration(Y.shape[1], rec.fs, band[0], "oma_fdd")
-    nper = _fdd_nperseg(nperseg, Y.shape[1], rec.fs, band)
+    nper = _fdd_nperseg(nperseg, Y.shape[1])
     if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer))
                                 or n_modes < 1):
         raise ParameterError(f"n_modes={n_modes!r} must be None or an integer >= 1")
-    if not 0 < float(mac_bell) < 1:
+    if not 0 < mac_bell < 1:
         raise ParameterError(f"mac_bell={mac_bell!r} must be between 0 and 1")
     f, G, w, n_seg, Gg = _csd_matrix(Y, rec.fs, nper)
     U, S, _ = np.linalg.svd(G)

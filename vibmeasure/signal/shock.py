@@ -298,9 +298,15 @@ def transmissibility(rec, *, base, top, model=None, nperseg: int | None = None, 
     if ub and ut and ub != ut:
         xt = _units.convert(xt, ut, ub)
     n = xb.size
-    nper = int(nperseg) if nperseg is not None else int(min(2 ** int(np.log2(max(n // 16, 64))), 2 ** 16))
-    if not 16 <= nper <= n // 2:
-        raise ParameterError(f"nperseg={nperseg!r} must be from 16 to half the record ({n // 2})")
+    if nperseg is None:
+        nper = int(min(2 ** int(np.log2(max(n // 16, 64))), 2 ** 16, n // 2))
+    elif isinstance(nperseg, bool) or not isinstance(nperseg, (int, np.integer)) or not 16 <= nperseg <= n // 2:
+        raise ParameterError(f"nperseg={nperseg!r} must be an integer from 16 to half the record ({n // 2})")
+    else:
+        nper = int(nperseg)
+    min_coherence = positive(min_coherence, "min_coherence")
+    if min_coherence >= 1:
+        raise ParameterError(f"min_coherence={min_coherence} must be between 0 and 1")
     f, Gbb = welch(xb, fs=rec.fs, nperseg=nper)
     _, Gtt = welch(xt, fs=rec.fs, nperseg=nper)
     _, Gbt = csd(xb, xt, fs=rec.fs, nperseg=nper)
