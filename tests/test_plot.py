@@ -83,3 +83,87 @@ def test_every_plot_labels_its_axes_with_quantity_and_unit():
         assert lab and ("[" in lab and "]" in lab), f"axis label without a unit: {lab!r}"
     assert "unknown" not in labels[0]
     plt.close("all")
+
+
+def _overlaps(a, b):
+    return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
+
+
+def test_peak_labels_never_print_on_top_of_each_other():
+    # ten tones, five of them 1.5 Hz apart: labelled naively their numbers overprint; every label
+    # drawn must stand clear of every other, and the strongest peak is always labelled
+    import matplotlib.pyplot as plt
+    from vibmeasure.plot import plot_spectrum
+    fs = 2048.0
+    t = np.arange(2 ** 15) / fs
+    tones = [(100, 1.0), (101.5, 0.9), (103, 0.8), (104.5, 0.85), (106, 0.7), (300, 0.5), (302, 0.45),
+             (304, 0.4), (500, 0.3), (700, 0.2)]
+    x = sum(a * np.sin(2 * np.pi * f * t) for f, a in tones)
+    spec = vm.amplitude_spectrum(vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="m/s^2"))
+    peaks = vm.pick_peaks(spec, n=10)
+    ax = plot_spectrum(spec, peaks=peaks)
+    ax.figure.canvas.draw()
+    boxes = [a.get_window_extent() for a in ax.texts]
+    assert len(boxes) >= 6  # most are labelled
+    for i in range(len(boxes)):
+        for j in range(i):
+            assert not _overlaps(boxes[i], boxes[j]), (ax.texts[i].get_text(), ax.texts[j].get_text())
+    assert "100" in {t.get_text() for t in ax.texts}
+    plt.close("all")
+
+
+def test_envelope_spectrum_axis_ends_where_its_content_ends_and_db_is_labelled():
+    # the squared envelope of a 1.2 kHz wide band holds nothing above 1.2 kHz: the axis must not run
+    # to fs/2 = 6.4 kHz (reason: the fault lines would be squeezed into the first fifth of the plot)
+    import matplotlib.pyplot as plt
+    from vibmeasure.plot import plot_spectrum
+    rec = vm.synth.machine(fault="bearing_outer_race", rpm=1500.0, fs=12800.0, duration=2.0, seed=1)
+    env = vm.envelope_spectrum(rec, band=(2000.0, 3200.0))
+    ax = plot_spectrum(env)
+    assert 1100.0 < ax.get_xlim()[1] < 2200.0, ax.get_xlim()
+    ax = plot_spectrum(vm.psd(rec), db=True)
+    assert "dB re 1" in ax.get_ylabel() and ax.get_yscale() == "linear"
+    lo, hi = ax.get_ylim()
+    assert hi - lo <= 110  # a readable dynamic range, not 300 dB down to the round-off
+    with pytest.raises(vm.ParameterError, match="fmax"):
+        plot_spectrum(env, fmax=-1.0)
+    plt.close("all")
+
+
+def test_ringdown_plot_shows_the_band_passed_record_when_the_fit_had_a_band():
+    # an impact transient at 150 Hz over a 12 Hz decay: with band=(5, 30) the fit reports the 12 Hz
+    # mode, and the picture must show the band's signal so the fit can be seen on the data
+    import matplotlib.pyplot as plt
+    rec = vm.synth.free_decay(fn=[12.0, 150.0], zeta=[0.01, 0.05], amplitude=[1.0, 20.0], fs=1000.0,
+                              duration=6.0, snr_db=50, seed=4)
+    est = vm.ringdown(rec, band=(5.0, 30.0))
+    ax, axr = plot_ringdown(rec, est)
+    data = ax.get_lines()[0]
+    assert "band-passed 5-30 Hz" in data.get_label()
+    late = data.get_xdata() > 0.3  # after the filter's own start-up at the record's abrupt first sample
+    assert np.max(np.abs(data.get_ydata()[late])) < 1.2  # the 20-unit 150 Hz transient is filtered out
+    res = axr.get_lines()[0]
+    assert np.std(res.get_ydata()[res.get_xdata() > 1.0]) < 0.02  # the fit lies on the band's data (filter settled)
+    assert ax.get_ylim()[1] < 2.0  # framed on the decay, not on the filter's start-up
+    plt.close("all")
+
+
+def test_every_plot_shares_the_one_style():
+    # one style module: constrained layout (no clipped labels) and the same fonts in every figure
+    import matplotlib.pyplot as plt
+    from matplotlib.layout_engine import ConstrainedLayoutEngine
+    from vibmeasure import plot as P
+    from vibmeasure.plotstyle import STYLE
+    rec = vm.synth.free_decay(fn=12.0, zeta=0.02, fs=500.0, duration=6.0, snr_db=40, seed=2,
+                              quantity="acceleration", unit="m/s^2")
+    freq = np.arange(0, 50.0625, 0.0625)
+    frf = vm.synth.modal_frf(freq, fn=[10.0, 30.0], zeta=[0.02, 0.02], shapes=[[1.0, 0.7]])
+    est_m = vm.fit_modes(frf, band=(2, 45))
+    figs = [P.plot_ringdown(rec, vm.ringdown(rec))[0].figure, P.plot_spectrum(vm.psd(rec)).figure,
+            P.plot_frf(frf, est=est_m)[0].figure, P.plot_nyquist(frf).figure,
+            P.plot_stabilisation(est_m, frf=frf).figure, P.plot_mac(vm.mac(np.eye(2))).figure]
+    for fig in figs:
+        assert isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine)
+        ax = fig.axes[0]
+        assert ax.xaxis.label.get_fontsize() == STYLE["axes.labelsize"]
+    plt.close("all")

@@ -8,13 +8,26 @@ from __future__ import annotations
 
 import numpy as np
 
+import functools
+
 from .core._validate import name_index, response_channel
 from .core.errors import ParameterError
 from .core.record import Record
 from .core.results import ModalEstimate
+from .plotstyle import ANNOTATION_SIZE, COLORS, STYLE
 
 __all__ = ["plot_srs", "plot_singular_values", "plot_transmissibility", "plot_ringdown", "plot_spectrum", "plot_frf", "plot_nyquist", "plot_stabilisation", "plot_mac", "plot_diagnosis",
            "decay_model"]
+
+
+def _styled(fn):
+    """Draw inside the one vibmeasure style (plotstyle.STYLE): the same look for every figure."""
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        import matplotlib
+        with matplotlib.rc_context(STYLE):
+            return fn(*args, **kwargs)
+    return wrapper
 
 
 def decay_model(est: ModalEstimate, t: np.ndarray) -> np.ndarray:
@@ -28,6 +41,7 @@ def decay_model(est: ModalEstimate, t: np.ndarray) -> np.ndarray:
     return y
 
 
+@_styled
 def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
     """The record, the fitted decay and its envelope, and the residual (two stacked axes).
 
@@ -46,7 +60,15 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
         fig, axes = plt.subplots(2, 1, sharex=True, figsize=(9, 5.5), gridspec_kw={"height_ratios": [3, 1]})
     ax, axr = axes
     c = rec.channels[idx]
-    ax.plot(t, x, lw=0.6, color="0.45", label=f"{c.name} (measured)")
+    band = est.extras.get("band_hz")
+    what_data = "measured"
+    if band:  # the fit reports the band's modes: show the band's signal, or an impact transient hides the fit
+        from scipy import signal as _sig
+        lo, hi = float(band[0]), min(float(band[1]), 0.49 * rec.fs)
+        sos = _sig.butter(4, (max(lo, 1e-3 * rec.fs), hi), btype="bandpass", fs=rec.fs, output="sos")
+        x = _sig.sosfiltfilt(sos, x - np.median(x))
+        what_data = f"measured, band-passed {lo:.4g}-{hi:.4g} Hz"
+    ax.plot(t, x, lw=0.6, color=COLORS["measured"], label=f"{c.name} ({what_data})")
     t0 = float(est.extras.get("start_s", rec.t0))
     if est.method == "ml" and np.isfinite(est.amplitude).any():
         sel = t >= t0
@@ -55,17 +77,30 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
         tt = t[sel] - t0
         model = decay_model(est, tt)
         offset = np.median(x[sel] - model)
-        ax.plot(t[sel], model + offset, lw=0.8, color="C0", label="fitted decay")
+        ax.plot(t[sel], model + offset, lw=0.8, color=COLORS["fit"], label="fitted decay")
         env = np.zeros_like(tt)
         for fn, z, a in zip(est.fn, est.zeta, est.amplitude):
             if np.isfinite(z) and np.isfinite(fn):
                 env += abs(a) * np.exp(-z * 2 * np.pi * fn * tt)
-        ax.plot(t[sel], offset + env, "--", lw=1.0, color="C3", label="envelope")
-        ax.plot(t[sel], offset - env, "--", lw=1.0, color="C3")
-        axr.plot(t[sel], x[sel] - model - offset, lw=0.5, color="C2")
+        ax.plot(t[sel], offset + env, "--", lw=1.0, color=COLORS["envelope"], label="envelope")
+        ax.plot(t[sel], offset - env, "--", lw=1.0, color=COLORS["envelope"])
+        axr.plot(t[sel], x[sel] - model - offset, lw=0.5, color=COLORS["residual"])
         axr.set_ylabel(f"residual [{rec.channels[idx].unit or '-'}]")
     else:
         axr.set_visible(False)
+    if band:  # frame the decay, not the filter's start-up on the record's first samples
+        settled = t >= t[0] + 3.0 / max(float(band[0]), 1e-3 * rec.fs)
+        if settled.sum() > 16:
+            top = float(np.max(np.abs(x[settled])))
+            fitted = est.method == "ml" and np.isfinite(est.amplitude).any()
+            if fitted:
+                top = max(top, float(np.max(np.abs(model + offset))))
+            ax.set_ylim(-1.15 * top, 1.15 * top)
+            if fitted:
+                late = settled[sel]
+                r = np.abs((x[sel] - model - offset)[late])
+                if r.size:
+                    axr.set_ylim(-1.3 * r.max(), 1.3 * r.max())
     ax.axvline(t0, color="k", lw=0.6, ls=":")
     lines = [f"{fn:.5g} Hz, zeta {z:.4g}" + (f" ± {zs:.2g}" if np.isfinite(zs) else "")
              for fn, z, zs in zip(est.fn, est.zeta, est.zeta_std)]
@@ -80,40 +115,98 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
     return ax, axr
 
 
-def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: bool | None = None):
+@_styled
+def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: bool | None = None,
+                  db: bool = False, fmax: float | None = None):
     """A spectrum (one or all channels) with optional picked peaks and labelled reference lines.
 
     ``lines`` maps a label to a frequency in Hz (e.g. {"BPFO": 107.4}); ``log`` defaults to a
-    logarithmic amplitude axis for PSDs.
+    logarithmic amplitude axis for PSDs; ``db=True`` draws decibels re 1 unit (20 log10 of
+    amplitudes, 10 log10 of powers). The frequency axis ends at ``fmax``, by default where the
+    content ends (an envelope spectrum holds nothing above its demodulation bandwidth). Peak labels
+    that would print on top of each other are left out, strongest peaks first.
     """
     import matplotlib.pyplot as plt
     from .core.results import Spectrum
     if not isinstance(spec, Spectrum):
         raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
+    if fmax is not None and not (np.isfinite(fmax) and fmax > 0):
+        raise ParameterError(f"fmax={fmax!r} must be a positive frequency in Hz")
     if ax is None:
         _, ax = plt.subplots(figsize=(9, 4.5))
     rows = range(spec.n_channels) if channel is None else [name_index(spec.channels, channel)]
+    power = spec.kind in ("psd", "power")
+
+    def scaled(v):
+        v = np.abs(np.asarray(v, float))
+        if not db:
+            return v
+        return (10 if power else 20) * np.log10(np.maximum(v, 1e-300))
     for i in rows:
-        ax.plot(spec.freq, np.abs(spec.values[i]), lw=0.7, label=spec.channels[i])
+        ax.plot(spec.freq, scaled(spec.values[i]), lw=0.7, label=spec.channels[i])
+    top = fmax if fmax is not None else _content_end(spec, rows)
+    ax.set_xlim(spec.freq[0], min(top, spec.freq[-1]))
+    if not db and (log if log is not None else power):
+        ax.set_yscale("log")
+    if db:
+        vis = (spec.freq > 0) & (spec.freq <= top)
+        peak = max(float(np.max(scaled(spec.values[i][vis]))) for i in rows) if vis.any() else 0.0
+        ax.set_ylim(bottom=peak - (100 if power else 80), top=peak + 6)
     if peaks is not None and len(peaks):
-        ax.plot(peaks.freq, peaks.amplitude, "v", color="C3", ms=5, label="peaks")
-        for f, a in zip(peaks.freq[:10], peaks.amplitude[:10]):
-            ax.annotate(f"{f:.4g}", (f, a), textcoords="offset points", xytext=(3, 4), fontsize=7)
+        ax.plot(peaks.freq, scaled(peaks.amplitude), "v", color=COLORS["mode"], ms=5, label="peaks")
+        _label_without_collisions(ax, peaks.freq[:10], scaled(peaks.amplitude[:10]),
+                                  [f"{f:.4g}" for f in peaks.freq[:10]])
     for label, f in (lines or {}).items():
         ax.axvline(f, color="0.5", lw=0.6, ls="--")
-        ax.text(f, 1.0, f" {label}", transform=ax.get_xaxis_transform(), rotation=90, va="top", fontsize=7)
-    if log if log is not None else spec.kind in ("psd", "power"):
-        ax.set_yscale("log")
+        ax.text(f, 1.0, f" {label}", transform=ax.get_xaxis_transform(), rotation=90, va="top",
+                fontsize=ANNOTATION_SIZE)
     ax.set_xlabel("frequency [Hz]")
     ylab = {"amplitude": f"amplitude ({spec.params.get('scaling', 'peak')})", "psd": "PSD", "power": "power",
             "envelope": "squared-envelope spectrum"}.get(spec.kind, spec.kind)
-    ax.set_ylabel(f"{ylab} [{spec.unit or '-'}]")
+    unit = spec.unit or "-"
+    ax.set_ylabel(f"{ylab} [dB re 1 {unit}]" if db else f"{ylab} [{unit}]")
     ax.set_title(f"{spec.kind}: window {spec.params.get('window', '?')}, nperseg {spec.params.get('nperseg', '?')}, "
-                 f"df {spec.df:.4g} Hz, {spec.params.get('n_averages', 1)} averages", fontsize=9)
-    ax.legend(loc="upper right", fontsize=8)
+                 f"df {spec.df:.4g} Hz, {spec.params.get('n_averages', 1)} averages")
+    ax.legend(loc="upper right")
     return ax
 
 
+def _content_end(spec, rows) -> float:
+    """The frequency above which every drawn channel stays 60 dB (amplitude) below its largest
+    non-DC line, with a 5 % margin; the whole axis when the content reaches Nyquist."""
+    f = spec.freq
+    power = spec.kind in ("psd", "power")
+    last = 0.0
+    for i in rows:
+        v = np.abs(np.asarray(spec.values[i], float))
+        v = v ** 0.5 if power else v
+        nz = f > 0
+        if not nz.any() or not np.any(v[nz] > 0):
+            return float(f[-1])
+        above = np.flatnonzero(nz & (v > 1e-3 * np.max(v[nz])))
+        last = max(last, float(f[above[-1]]))
+    return float(f[-1]) if last >= 0.95 * f[-1] else min(float(f[-1]), 1.05 * last)
+
+
+def _label_without_collisions(ax, xs, ys, texts, *, size: float = ANNOTATION_SIZE):
+    """Label points (strongest first) just above them, each where it overlaps no label placed
+    before; a label that fits nowhere near its point is left out."""
+    ax.autoscale_view()
+    to_px = ax.transData.transform
+    pt = ax.figure.dpi / 72.0
+    placed: list[tuple[float, float, float, float]] = []
+    for k in np.argsort(-np.asarray(ys, float), kind="stable"):
+        px, py = to_px((xs[k], ys[k]))
+        w, h = 0.62 * size * len(texts[k]) * pt, 1.25 * size * pt
+        for dy in (4.0, 4.0 + 1.4 * size, 4.0 + 2.8 * size):
+            box = (px + 2 * pt, px + 2 * pt + w, py + dy * pt, py + dy * pt + h)
+            if not any(box[0] < b[1] and b[0] < box[1] and box[2] < b[3] and b[2] < box[3] for b in placed):
+                ax.annotate(texts[k], (xs[k], ys[k]), textcoords="offset points", xytext=(2, dy), fontsize=size)
+                placed.append(box)
+                break
+
+
+@_styled
 def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
     """Bode plot (magnitude, phase) of one FRF with its coherence, and the FRF synthesised from
     a fit_modes estimate when given. Returns (magnitude, phase, coherence) axes."""
@@ -127,16 +220,20 @@ def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
         fig, axes = plt.subplots(3, 1, sharex=True, figsize=(9, 7), gridspec_kw={"height_ratios": [3, 1.5, 1]})
     am, ap, ac = axes
     h = frf.h[o, i]
-    am.semilogy(frf.freq, np.abs(h), lw=0.8, label=f"{frf.outputs[o]}/{frf.inputs[i]} ({frf.estimator or 'data'})")
-    ap.plot(frf.freq, np.degrees(np.angle(h)), lw=0.8)
+    am.semilogy(frf.freq, np.abs(h), lw=0.8, color=COLORS["measured"], label=f"{frf.outputs[o]}/{frf.inputs[i]} ({frf.estimator or 'data'})")
+    ap.plot(frf.freq, np.degrees(np.angle(h)), lw=0.8, color=COLORS["measured"])
     if est is not None and "poles" in est.extras:
         from .identify.modal import synthesize_frf
         band = est.extras.get("band_hz", (frf.freq[0], frf.freq[-1]))
         sel = (frf.freq >= band[0]) & (frf.freq <= band[1]) & (frf.freq > 0)
-        hs = synthesize_frf(est, frf.freq[sel])
-        if est.extras.get("outputs") and frf.outputs[o] in est.extras["outputs"]:
-            k = est.extras["outputs"].index(frf.outputs[o])
-            am.semilogy(frf.freq[sel], np.abs(hs[k]), "--", lw=0.9, label="synthesised (modes only)")
+        full = "residual_terms" in est.extras
+        hs = synthesize_frf(est, frf.freq[sel], residuals=full)
+        rows = est.extras.get("rows") or est.extras.get("outputs") or []
+        name = f"{frf.outputs[o]}/{frf.inputs[i]}" if est.extras.get("rows") else frf.outputs[o]
+        if name in rows:
+            k = rows.index(name)
+            am.semilogy(frf.freq[sel], np.abs(hs[k]), "--", lw=0.9, color=COLORS["fit"],
+                        label="synthesised (modes + residual terms)" if full else "synthesised (modes only)")
         for f in est.fn:
             am.axvline(f, color="0.6", lw=0.5, ls=":")
     n_avg = frf.params.get("n_averages")
@@ -149,12 +246,13 @@ def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
     ac.set_ylim(0, 1.05)
     am.set_ylabel(f"|H| {frf.form} [{frf.unit or '-'}]")
     ap.set_ylabel("phase [deg]")
-    ac.set_ylabel("coherence")
+    ac.set_ylabel("coherence [-]")
     ac.set_xlabel("frequency [Hz]")
-    am.legend(fontsize=8)
+    am.legend(loc="upper right")
     return am, ap, ac
 
 
+@_styled
 def plot_nyquist(frf, *, output=0, input=0, band=None, ax=None):
     """Nyquist plot (real vs imaginary) of one FRF, optionally within a band."""
     import matplotlib.pyplot as plt
@@ -172,6 +270,7 @@ def plot_nyquist(frf, *, output=0, input=0, band=None, ax=None):
     return ax
 
 
+@_styled
 def plot_stabilisation(est, *, frf=None, ax=None):
     """The stabilisation diagram of a fit_modes or oma_ssi estimate: poles per model order (o new, f
     stable in frequency, d also damping, s stable in frequency and damping, and for oma_ssi in shape),
@@ -214,6 +313,7 @@ def plot_stabilisation(est, *, frf=None, ax=None):
     return ax
 
 
+@_styled
 def plot_mac(matrix, *, labels=None, ax=None):
     """MAC matrix as an image with the values written in."""
     import matplotlib.pyplot as plt
@@ -233,6 +333,7 @@ def plot_mac(matrix, *, labels=None, ax=None):
     return ax
 
 
+@_styled
 def plot_diagnosis(rec, diag, *, axes=None):
     """The squared-envelope spectrum that carries the bearing evidence (in dB over its floor) with the
     winning family's comb at its slip, its sidebands and the other families' expected lines; the fast
@@ -348,6 +449,7 @@ def _plot_kurtogram(ax, kg, band):
                  f"(level {lev:g}); outlined: band of the evidence", fontsize=8)
 
 
+@_styled
 def plot_trend(store, *, asset: str, point: str, metric: str, task: str | None = None, baseline_count: int = 8,
                ax=None):
     """One metric of one point over time: the measurements, the baseline band (mean +- std of the
@@ -384,6 +486,7 @@ def plot_trend(store, *, asset: str, point: str, metric: str, task: str | None =
     return ax
 
 
+@_styled
 def plot_backbone(est: ModalEstimate, *, mode: int = 0, axes=None):
     """The backbone of one mode of a ring-down estimate: fn and zeta versus amplitude (error bars:
     one std per window) with the weakly nonlinear model of ``extras["backbone_model"]`` drawn over."""
@@ -441,6 +544,7 @@ def save_figure(fig, path, *, dpi: int = 120) -> None:
         plt.close(fig)
 
 
+@_styled
 def plot_comparison(cmp, *, rtol_fn: float = 0.02, against: str = "model", ax=None):
     """Deviation of each measured fn from its prediction (%), coloured by verdict, with the alarm
     tolerance +-rtol_fn and, where known, one-std error bars."""
@@ -461,6 +565,7 @@ def plot_comparison(cmp, *, rtol_fn: float = 0.02, against: str = "model", ax=No
     return ax
 
 
+@_styled
 def plot_srs(spec, *, ax=None, tripartite: bool | None = None):
     """Shock response spectrum on log axes. For pseudo-velocity output (or ``tripartite=True`` with
     any output) the tripartite grid: pseudo-velocity against frequency, with lines of constant
@@ -505,6 +610,7 @@ def plot_srs(spec, *, ax=None, tripartite: bool | None = None):
     return ax
 
 
+@_styled
 def plot_singular_values(est, *, ax=None, n: int | None = None):
     """Singular values of the output cross-spectral matrix (oma_fdd), in dB, with the selected modes
     and their EFDD bells marked."""
@@ -527,6 +633,7 @@ def plot_singular_values(est, *, ax=None, n: int | None = None):
     return ax
 
 
+@_styled
 def plot_transmissibility(tr, *, ax=None):
     """Measured |T| (and the model's, where given) on log axes, coherence below, the isolation
     region (|T| < 1) shaded."""

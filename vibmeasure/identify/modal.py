@@ -521,6 +521,11 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
             for o in range(H.shape[0])]
     extras = {"poles": [[float(l.real), float(l.imag)] for l in lam[keep]],
               "residues": [[[float(x.real), float(x.imag)] for x in R[:, k]] for k in keep],
+              "residual_terms": _residual_terms(coef, sw, m),
+              # poles fitted but not reported (outside the band, non-physical): part of the residual model
+              "residual_poles": [[float(lam[k].real), float(lam[k].imag)] for k in range(m) if k not in keep],
+              "residual_residues": [[[float(x.real), float(x.imag)] for x in R[:, k]] for k in range(m)
+                                    if k not in keep],
               "band_hz": list(band), "frac": frac, "noise_std_per_output": list(1 / sw),
               "stabilisation": table, "n_orders": n_orders, "exp_window_tau_s": tau,
               "exp_window_added_zeta": [float(1 / (tau * wn[k])) for k in keep] if tau else None,
@@ -549,17 +554,39 @@ def synthesize_frf_from(f, lam, R, coef, sw, m):
     return (B @ coef).T / sw[:, None]
 
 
-def synthesize_frf(est: ModalEstimate, freq) -> np.ndarray:
-    """Modal part of the FRFs (n_outputs, n_freq) from a fit_modes estimate's poles and residues."""
+def _residual_terms(coef, sw, m) -> list[dict]:
+    """Per FRF row, the fitted residual terms in the FRF's units: H_res = lower/(iw)^2 + constant + upper iw."""
+    c = coef[2 * m:2 * m + 6] / sw[None, :]
+    return [{"lower": [float(c[0, r]), float(c[1, r])], "constant": [float(c[2, r]), float(c[3, r])],
+             "upper": [float(c[4, r]), float(c[5, r])]} for r in range(c.shape[1])]
+
+
+def synthesize_frf(est: ModalEstimate, freq, *, residuals: bool = False) -> np.ndarray:
+    """FRFs (n_rows, n_freq) synthesised from a fit_modes estimate's poles and residues: the modal
+    part only, or with ``residuals=True`` the whole fitted model: also the residual terms (lower
+    1/(iw)^2, constant, upper iw) and the poles fitted but not reported (outside the band), which
+    stand for the modes outside the band; the rows are the outputs (times inputs for a
+    poly-reference fit, in ``extras["rows"]`` order)."""
     if "poles" not in est.extras or "residues" not in est.extras:
         raise ParameterError("est must come from vm.fit_modes (it needs poles and residues)")
     w = 2 * np.pi * np.asarray(freq, float)
+    if residuals and np.any(w <= 0):
+        raise ParameterError("freq must be > 0 where the residual terms are synthesised (the lower term is 1/(iw)^2)")
     iw = 1j * w
     out = 0
-    for (re, im), res in zip(est.extras["poles"], est.extras["residues"]):
+    pairs = list(zip(est.extras["poles"], est.extras["residues"]))
+    if residuals:
+        pairs += list(zip(est.extras.get("residual_poles", []), est.extras.get("residual_residues", [])))
+    for (re, im), res in pairs:
         l = re + 1j * im
         R = np.array([a + 1j * b for a, b in res])
         out = out + R[:, None] / (iw - l) + np.conj(R)[:, None] / (iw - np.conj(l))
+    if residuals:
+        terms = est.extras.get("residual_terms")
+        if terms is None:
+            raise ParameterError("this estimate carries no residual terms (it predates them): refit with vm.fit_modes")
+        res = np.array([[complex(*t["lower"]), complex(*t["constant"]), complex(*t["upper"])] for t in terms])
+        out = out + res[:, :1] / iw ** 2 + res[:, 1:2] + res[:, 2:3] * iw
     return np.asarray(out)
 
 

@@ -306,6 +306,7 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     x_all = clean_signal(rec, idx, min_samples=16)
     fsr = rec.fs
     band = check_band(band, fsr)
+    band_asked = band
     if n_modes != "auto":
         if isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer)) or n_modes < 1:
             raise ParameterError(f"n_modes={n_modes!r} must be 'auto' or an integer >= 1")
@@ -545,7 +546,8 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
               "tones_hz": fd_all[tones].tolist(), "channel": rec.channels[idx].name,
               "nuisance": [{"fn_hz": fn[k], "zeta": zeta[k], "why": "baseline wander" if wander[k] else "transient"}
                            for k in np.flatnonzero(nuisance)],
-              "rejected_modes": rejected, "notes": notes}
+              "rejected_modes": rejected, "notes": notes,
+              "band_hz": None if band_asked is None else [float(band_asked[0]), float(band_asked[1])]}
     ik = np.asarray(report)
     fn_r, zeta_r = fn[ik].copy(), zeta[ik].copy()
     fn_std_r, zeta_std_r = fn_std[ik].copy(), zeta_std[ik].copy()
