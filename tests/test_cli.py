@@ -127,7 +127,8 @@ def test_spectrum_psd_csv_and_plot(sample_dir, tmp_path):
     assert code == 0, err
     import pandas as pd
     tab = pd.read_csv(csv)
-    assert list(tab.columns) == ["freq_hz", "acc_de"] and tab.freq_hz.min() >= 10 and tab.freq_hz.max() <= 200
+    assert list(tab.columns) == ["freq [Hz]", "acc_de [g^2/Hz]"]  # every header carries its unit
+    assert tab["freq [Hz]"].min() >= 10 and tab["freq [Hz]"].max() <= 200
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 
@@ -212,3 +213,57 @@ def test_every_option_of_every_command_has_help_text():
                 missing += [(name, b.dest) for b in sp._actions
                             if b.help is None and not isinstance(b, argparse._HelpAction)]
     assert not missing, missing
+
+
+def _bare_hammer_csv(tmp_path):
+    # the same hammer test as a plain CSV with a time column: no quantities, no units
+    import pandas as pd
+    from tests.test_frf import impact_record
+    rec = impact_record()
+    df = pd.DataFrame(rec.data.T, columns=list(rec.names))
+    df.insert(0, "time", rec.time)
+    p = tmp_path / "bare_hammer.csv"
+    df.to_csv(p, index=False)
+    return p
+
+
+def test_frf_and_modes_take_quantity_and_unit_per_channel_and_write_csv_with_units(tmp_path):
+    import pandas as pd
+    p = _bare_hammer_csv(tmp_path)
+    csv = tmp_path / "frf.csv"
+    code, out, err = run(["frf", str(p), "--input", "hammer", "--impact", "--unit", "mm", "--unit", "hammer=N",
+                          "--json", "--csv", str(csv)])
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["form"] == "receptance"  # --unit mm says displacement
+    tab = pd.read_csv(csv)
+    assert list(tab.columns)[:7] == ["freq [Hz]", "output", "input", "re [mm/N]", "im [mm/N]", "magnitude [mm/N]",
+                                     "phase [deg]"]
+    assert set(tab["output"]) == {"a0", "a1", "a2"} and len(tab) == 3 * tab["freq [Hz]"].nunique()
+    # velocity data named so: the FRF is a mobility
+    code, out, err = run(["frf", str(p), "--input", "hammer", "--impact", "--quantity", "velocity", "--json"])
+    assert code == 0 and json.loads(out)["form"] == "mobility", err
+    modes_csv = tmp_path / "modes.csv"
+    code, out, err = run(["modes", str(p), "--input", "hammer", "--impact", "--band", "5", "150",
+                          "--quantity", "displacement", "--csv", str(modes_csv)])
+    assert code == 0, err
+    m = pd.read_csv(modes_csv)
+    assert list(m.columns)[:5] == ["mode", "fn [Hz]", "fn_std [Hz]", "zeta [-]", "zeta_std [-]"]
+    np.testing.assert_allclose(m["fn [Hz]"], [21.3, 57.9, 110.4], rtol=5e-4)  # the synthetic system's modes
+    # bad per-channel settings are named errors, and nothing is written
+    bad = tmp_path / "bad.csv"
+    code, _, err = run(["frf", str(p), "--input", "hammer", "--impact", "--quantity", "a9=velocity", "--csv", str(bad)])
+    assert code == 2 and "'a9' is not in the file" in err and not bad.exists()
+    code, _, err = run(["frf", str(p), "--input", "hammer", "--impact", "--quantity", "a0=velocity", "--unit", "a0=g"])
+    assert code == 2 and "'a0'" in err and "velocity" in err
+    code, _, err = run(["frf", str(p), "--input", "hammer", "--impact", "--quantity", "speed"])
+    assert code == 2 and "must be displacement, velocity, acceleration or force" in err
+
+
+def test_model_help_documents_the_toml_format(capsys):
+    from vibmeasure.cli import main
+    with pytest.raises(SystemExit):
+        main(["model", "--help"])
+    text = capsys.readouterr().out
+    for must in ('type = "sdof"', 'k = "40 N/mm"', "modal_zeta", "bc", "units:"):
+        assert must in text

@@ -82,6 +82,16 @@ def _parser() -> argparse.ArgumentParser:
                                                             "exponential windows (added damping removed)")
         q.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
         q.add_argument("--variable", help="MATLAB variable holding a complex FRF (e.g. Hf_chan_2)")
+        q.add_argument("--quantity", action="append", metavar="[CHANNEL=]QUANTITY",
+                       help="physical quantity of a channel when the file does not say: displacement, velocity, "
+                            "acceleration or force; CHANNEL= names the channel, without it every response channel "
+                            "(repeatable); it sets the FRF form (receptance, mobility, accelerance)")
+        q.add_argument("--unit", action="append", metavar="[CHANNEL=]UNIT",
+                       help="unit of a channel when the file does not say (m, mm/s, g, m/s^2, N, ...); CHANNEL= "
+                            "names the channel, without it every response channel (repeatable)")
+        q.add_argument("--csv", metavar="OUT.csv", help="write the FRFs (frf: re, im, magnitude, phase, coherence "
+                                                        "per line) or the modes (modes: one row per mode) as a "
+                                                        "table whose header carries the units")
         if name == "modes":
             q.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"), required=True,
                            help="frequency band to fit (Hz)")
@@ -91,8 +101,10 @@ def _parser() -> argparse.ArgumentParser:
         q.add_argument("--plot", metavar="OUT.png", help="write a picture (Bode + coherence, or the "
                                                          "stabilisation diagram for modes)")
 
+    from .models.loader import TOML_FORMAT
     md = sub.add_parser("model", help="predictions of a model described in a TOML file",
-                        description="Natural frequencies and damping a model predicts (vm.models.load).")
+                        description="Natural frequencies and damping a model predicts (vm.models.load).",
+                        epilog=TOML_FORMAT, formatter_class=argparse.RawDescriptionHelpFormatter)
     md.add_argument("file", help="model.toml")
     md.add_argument("--modes", type=int, default=3, help="modes of a continuum (default 3)")
     md.add_argument("--json", action="store_true", help="print one JSON document")
@@ -238,9 +250,9 @@ def _main_srs(args, out, err) -> int:
     sp = srs(rec, fn=fn, zeta=args.zeta, Q=args.q, kind=args.kind, output=args.output, channel=args.channel,
              octave=args.octave, pulse_end=args.pulse_end)
     if args.csv:
-        from .io._common import atomic_path
-        with atomic_path(args.csv) as tmp:
-            sp.to_frame().to_csv(tmp, index=False, float_format="%.10g")
+        from .io._common import write_table
+        df = sp.to_frame()
+        write_table(df, args.csv, {c: sp.unit for c in df.columns if c != "fn_hz"})
     if args.json:
         doc = {"command": "srs", "file": str(args.file), "channel": sp.channel, "output": sp.output, "unit": sp.unit,
                "zeta": sp.zeta, "q": (1 / (2 * sp.zeta)) if sp.zeta > 0 else None, "input_peak": sp.input_peak,
@@ -522,10 +534,50 @@ def _get_frf(args):
         if chans[i].quantity != "force":
             chans[i] = dataclasses.replace(chans[i], quantity="force", unit="")
             rec = rec.replace(channels=tuple(chans), note=f"channel {args.input!r} marked as force")
+    rec = _label_channels(rec, getattr(args, "quantity", None), getattr(args, "unit", None), args.input)
     if args.impact:
         return F.impact_frf(rec, input=args.input, outputs=args.output, estimator=args.estimator)
     return F.estimate_frf(rec, input=args.input, outputs=args.output, estimator=args.estimator,
                           window=args.window, nperseg=args.nperseg)
+
+
+def _channel_settings(values, what, rec, default_targets):
+    """Parse repeated [CHANNEL=]VALUE options into {channel name: value}."""
+    out = {}
+    for v in values or ():
+        name, sep, val = v.rpartition("=")
+        if sep and name:
+            if name not in rec.names:
+                raise VibMeasureError(f"--{what} {v!r}: channel {name!r} is not in the file; channels are {rec.names}")
+            out[name] = val.strip()
+        else:
+            out.update({n: val.strip() for n in default_targets})
+    return out
+
+
+def _label_channels(rec, quantities, units, input_name):
+    """Set the quantity and unit of channels from --quantity/--unit ([CHANNEL=]VALUE, repeatable)."""
+    if not quantities and not units:
+        return rec
+    import dataclasses
+    from .core import units as U
+    force = rec.index(input_name) if input_name in rec.names else None
+    responses = [c.name for k, c in enumerate(rec.channels) if k != force and c.quantity != "force"]
+    q = _channel_settings(quantities, "quantity", rec, responses)
+    u = _channel_settings(units, "unit", rec, responses)
+    chans = list(rec.channels)
+    for k, c in enumerate(chans):
+        qk, uk = q.get(c.name, c.quantity), u.get(c.name, c.unit)
+        if qk not in ("displacement", "velocity", "acceleration", "force", "unknown"):
+            raise VibMeasureError(f"--quantity {qk!r} for channel {c.name!r} must be displacement, velocity, "
+                                  "acceleration or force")
+        try:
+            if qk == "unknown" and uk:
+                qk = U.quantity_of(uk)   # --unit g says acceleration
+            chans[k] = dataclasses.replace(c, quantity=qk, unit=uk)
+        except VibMeasureError as exc:
+            raise VibMeasureError(f"channel {c.name!r}: {exc}") from None
+    return rec.replace(channels=tuple(chans), note="quantity/unit set on the command line")
 
 
 def _uff_has_frf(p):
@@ -555,6 +607,8 @@ def _main_frf(args, out, err) -> int:
             print(f"vibmeasure: error: {exc}", file=err)
             return 2
     msgs = [str(w.message) for w in caught if issubclass(w.category, QualityWarning)]
+    if args.csv:
+        _frf_csv(args.csv, frf, est)
     from .core.results import _jsonable
     coh = None if frf.coherence is None else [float(np.mean(c)) for c in frf.coherence]
     info = {"form": frf.form, "estimator": frf.estimator, "outputs": list(frf.outputs), "inputs": list(frf.inputs),
@@ -582,9 +636,23 @@ def _main_frf(args, out, err) -> int:
                       f"{m['zeta_std']:9.2g}  {','.join(m['flags'])}", file=out)
     for m in msgs:
         print(f"vibmeasure: warning: {m}", file=err)
-    if args.plot:
-        print(f"vibmeasure: wrote {args.plot}", file=err)
+    for what in ("csv", "plot"):
+        if getattr(args, what):
+            print(f"vibmeasure: wrote {getattr(args, what)}", file=err)
     return 0
+
+
+def _frf_csv(path, frf, est):
+    """FRFs (one row per line, output and input) or, with an estimate, the modes as a table with units."""
+    from .io._common import write_table
+    if est is None:
+        df = frf.to_frame()
+        write_table(df, path, {"re": frf.unit, "im": frf.unit, "magnitude": frf.unit, "coherence": "",
+                               "random_error": ""})
+        return
+    df = est.to_frame()
+    df.insert(0, "mode", range(1, est.n_modes + 1))
+    write_table(df, path, {"mode": None, "zeta": "", "zeta_std": "", "amplitude": est.unit})
 
 
 class _Progress:
@@ -647,12 +715,11 @@ def _spectrum(args, out, err):
 
 def _spectrum_outputs(args, spec, found, band):
     if args.csv:
-        from .io._common import atomic_path
+        from .io._common import write_table
         df = spec.to_frame()
         if band:
             df = df[(df.freq_hz >= band[0]) & (df.freq_hz <= band[1])]
-        with atomic_path(args.csv) as tmp:
-            df.to_csv(tmp, index=False, float_format="%.10g")
+        write_table(df, args.csv, {c: spec.unit for c in spec.channels})
     if args.plot:
         ax = _plot_module().plot_spectrum(spec, peaks=found[0] if found else None)
         if band:

@@ -162,7 +162,7 @@ def estimate_frf(rec, *, input="force", outputs=None, estimator: str = "H1", npe
     forms = {form_of(c.quantity) for c in outs}
     form = forms.pop() if len(forms) == 1 else "unknown"
     err = np.broadcast_to(_random_error(coh, nseg)[:, None, :], H.shape).copy()
-    unit = f"{outs[0].unit}/{rec.channels[ii[0]].unit}" if outs[0].unit and rec.channels[ii[0]].unit else ""
+    unit = _frf_unit(outs, rec.channels[ii[0]])
     return FRF(np.fft.rfftfreq(nfft, 1 / rec.fs), H, form, coh, estimator, tuple(c.name for c in outs),
                tuple(rec.channels[i].name for i in ii), unit, err,
                {"window": window, "nperseg": nperseg, "noverlap": noverlap, "n_averages": nseg, "fs": rec.fs,
@@ -195,6 +195,12 @@ def find_hits(force, fs: float, *, threshold: float = 0.1, min_gap_s: float | No
         if not hits or s - hits[-1] >= gap:
             hits.append(s)
     return np.asarray(hits, int)
+
+
+def _frf_unit(outs, force) -> str:
+    """Unit of H: the outputs' common unit over the force's ('m/s^2/N'); '' when either is unknown."""
+    units = {c.unit for c in outs}
+    return f"{outs[0].unit}/{force.unit}" if len(units) == 1 and outs[0].unit and force.unit else ""
 
 
 def impact_frf(rec, *, input="force", outputs=None, record_length: float | None = None,
@@ -296,7 +302,7 @@ def impact_frf(rec, *, input="force", outputs=None, record_length: float | None 
     forms = {form_of(c.quantity) for c in outs}
     err = np.broadcast_to(_random_error(coh, navg)[:, None, :], H.shape).copy()
     frf = FRF(np.fft.rfftfreq(n, 1 / fsr), H, forms.pop() if len(forms) == 1 else "unknown", coh, estimator,
-              tuple(c.name for c in outs), (rec.channels[ii[0]].name,), "", err,
+              tuple(c.name for c in outs), (rec.channels[ii[0]].name,), _frf_unit(outs, rec.channels[ii[0]]), err,
               {"window": "force+exponential" if tau else ("force" if force_window else "boxcar"), "nperseg": n,
                "n_averages": int(navg), "fs": fsr, "exp_window_tau_s": tau, "hits_s": (starts + pre) / fsr,
                "double_hits": double, "flags": tuple(flags)})

@@ -172,6 +172,30 @@ def atomic_path(path: str | os.PathLike):
         raise
 
 
+def write_table(df, path: str | os.PathLike, units: dict) -> Path:
+    """Write a results table as CSV whose header carries every column's unit: ``name [unit]``
+    (``[-]`` for a ratio), text columns and counts (unit None) by name alone. ``units`` maps a column to its unit; a
+    ``_hz``/``_deg``/``_s`` suffix is turned into the bracket (``freq_hz`` -> ``freq [Hz]``).
+    Written atomically: never a half-written table."""
+    suffix = {"_hz": "Hz", "_deg": "deg", "_s": "s"}
+    names = {}
+    for c in df.columns:
+        if c in units:  # None: a count or label, no unit
+            names[c] = c if units[c] is None else f"{c} [{units[c] or '-'}]"
+            continue
+        for end, u in suffix.items():
+            if str(c).endswith(end):
+                names[c] = f"{str(c)[:-len(end)]} [{u}]"
+                break
+        else:
+            if df[c].dtype.kind in "fiuc":
+                raise ParameterError(f"write_table: numeric column {c!r} has no unit; give it in units=")
+            names[c] = c
+    with atomic_path(path) as tmp:
+        df.rename(columns=names).to_csv(tmp, index=False, float_format="%.10g")
+    return Path(path)
+
+
 def fs_from_time(t, *, source: str) -> tuple[float, float]:
     """Sampling rate and start time from a time column, refusing non-uniform sampling."""
     t = np.asarray(t, dtype=float).ravel()
