@@ -202,6 +202,39 @@ def modal_response(force, *, fs: float, fn, zeta, shapes, input_dof: int = 0, qu
     return out
 
 
+def hammer_test(*, fn, zeta, shapes, fs: float, hits=(0.2, 2.2, 4.2), duration: float | None = None,
+                peak_force: float = 100.0, width: float = 0.003, double_at: float | None = None,
+                input_dof: int = 0, quantity: str = "acceleration", noise: float = 1e-4, force_noise: float = 0.05,
+                seed=None) -> Record:
+    """A hammer test: half-sine force pulses (``peak_force`` N, ``width`` s) at the ``hits`` times
+    (s) on ``input_dof`` and the responses of every dof of a proportionally damped system, each
+    mode discretised exactly. ``double_at`` adds a second, weaker pulse (a double hit). Response
+    noise is ``noise`` times each channel's std; the force gets ``force_noise`` N of noise.
+    Channels: ``hammer`` (force, N) and ``a0``, ``a1``, ... (``quantity`` in SI units).
+    """
+    fs = positive(fs, "fs")
+    hits = np.atleast_1d(np.asarray(hits, float))
+    if hits.size < 1 or not np.all(np.isfinite(hits)) or np.any(hits < 0):
+        raise ParameterError(f"hits={hits.tolist()!r} must be one or more times >= 0 s")
+    width = positive(width, "width")
+    if width * fs < 3:
+        raise ParameterError(f"width={width} s is shorter than 3 samples at fs={fs} Hz: the pulse cannot be sampled")
+    T = float(hits.max() + 2.0) if duration is None else positive(duration, "duration")
+    n = int(round(T * fs))
+    t = np.arange(n) / fs
+    f = np.zeros(n)
+    pulses = [(h, peak_force) for h in hits] + ([] if double_at is None else [(float(double_at), 0.6 * peak_force)])
+    for h, a in pulses:
+        f += np.where((t >= h) & (t < h + width), np.sin(np.pi * (t - h) / width), 0.0) * a
+    y = modal_response(f, fs=fs, fn=fn, zeta=zeta, shapes=shapes, input_dof=input_dof, quantity=quantity)
+    rng = np.random.default_rng(seed)
+    y += noise * y.std(axis=1, keepdims=True) * rng.normal(size=y.shape)
+    f = f + force_noise * rng.normal(size=n)
+    unit = {"displacement": "m", "velocity": "m/s", "acceleration": "m/s^2"}[quantity]
+    chans = [Channel("hammer", "force", "N")] + [Channel(f"a{i}", quantity, unit) for i in range(y.shape[0])]
+    return Record(np.vstack([f, y]), fs=fs, channels=chans)
+
+
 _FAULTS = ("none", "unbalance", "misalignment", "looseness", "bearing_outer_race", "bearing_inner_race",
            "bearing_ball", "gear_mesh", "resonance")
 
