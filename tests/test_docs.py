@@ -64,3 +64,24 @@ def test_every_example_of_the_guide_runs(reader_folder):
     for picture in ("ringdown.png", "frf.png", "diagnosis.png", "trend.png", "srs.png"):
         assert (reader_folder / picture).stat().st_size > 10_000
     assert os.path.exists("beam-report.html")
+
+
+def test_the_gallery_draws_every_plot_it_shows(tmp_path):
+    # docs/make_gallery.py draws each picture of docs/gallery.md with the library's own plot calls
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("make_gallery", ROOT / "docs" / "make_gallery.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        written = mod.draw(tmp_path)
+    names = {p.name for p in written}
+    assert names == set(mod.PICTURES)
+    shown = set(re.findall(r"\]\(gallery/([\w.]+)\)", (ROOT / "docs" / "gallery.md").read_text()))
+    assert shown == names
+    for p in written:
+        assert p.read_bytes()[:4] == b"\x89PNG" and p.stat().st_size > 8_000
+    import vibmeasure.plot as P
+    public = {n for n in dir(P) if n.startswith("plot_")}
+    drawn = set(re.findall(r"\((plot_\w+)", " ".join(mod.PICTURES.values())))
+    assert public <= drawn, f"plots missing from the gallery: {sorted(public - drawn)}"

@@ -320,6 +320,7 @@ def plot_mac(matrix, *, labels=None, ax=None):
     m = np.asarray(matrix, float)
     if ax is None:
         _, ax = plt.subplots(figsize=(4.5, 4))
+    ax.grid(False)  # no grid lines across an image
     im = ax.imshow(m, vmin=0, vmax=1, cmap="Blues")
     for (r, c), v in np.ndenumerate(m):
         ax.text(c, r, f"{v:.2f}", ha="center", va="center", fontsize=8, color="w" if v > 0.6 else "k")
@@ -389,6 +390,7 @@ def plot_diagnosis(rec, diag, *, axes=None):
     if v is not None:
         ax_g.plot([-0.35, 0.35], [min(v, top)] * 2, color="k", lw=3)
         ax_g.set_title(f"ISO 10816-3\n{v:.2f} mm/s: zone {sev['zone']}", fontsize=8)
+    ax_g.grid(False)
     ax_g.set_xlim(-0.5, 0.6)
     ax_g.set_ylim(0, top)
     ax_g.set_xticks([])
@@ -437,6 +439,7 @@ def _plot_ses(ax, ses, diag, colors):
 def _plot_kurtogram(ax, kg, band):
     """Fast kurtogram (levels x frequency) with the band the evidence came from outlined."""
     img = kg.image("kurtosis")
+    ax.grid(False)  # no grid lines across an image
     ax.imshow(img, aspect="auto", origin="upper", cmap="viridis", interpolation="nearest",
               extent=(0, kg.fs / 2, len(kg.levels) - 0.5, -0.5))
     ax.set_yticks(range(len(kg.levels)), [f"{lv:g}" for lv in kg.levels])
@@ -523,45 +526,51 @@ def file_backend() -> None:
 
 
 def save_figure(fig, path, *, dpi: int = 120) -> None:
-    """Write a figure atomically (never a half-written picture), then close it, also on failure."""
-    import os
-    import tempfile
+    """Write a figure atomically (never a half-written picture, the usual file mode), then close it,
+    also on failure."""
     from pathlib import Path
     import matplotlib.pyplot as plt
+    from .io._common import atomic_path
     p = Path(path)
     try:
         if not p.parent.exists():
             raise ParameterError(f"{str(path)!r}: folder {str(p.parent)!r} does not exist")
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=p.suffix or ".png", dir=p.parent)
-        os.close(fd)
-        try:
-            fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
-            os.replace(tmp, p)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+        with atomic_path(p) as tmp:
+            fig.savefig(tmp, dpi=dpi, bbox_inches="tight", format=(p.suffix[1:] or "png").lower())
     finally:
         plt.close(fig)
 
 
 @_styled
-def plot_comparison(cmp, *, rtol_fn: float = 0.02, against: str = "model", ax=None):
+def plot_comparison(cmp, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.5, against: str = "model", ax=None):
     """Deviation of each measured fn from its prediction (%), coloured by verdict, with the alarm
-    tolerance +-rtol_fn and, where known, one-std error bars."""
+    tolerance +-rtol_fn and, where known, one-std error bars; on a figure of its own also the zeta
+    deviation (%) beside it, with its tolerance +-rtol_zeta. Returns the fn axes."""
     import matplotlib.pyplot as plt
+    ax_z = None
     if ax is None:
-        _, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
-    colors = {"ok": "C2", "watch": "C1", "alarm": "C3"}
-    for r in cmp.rows:
-        sd = r.get("fn_dev_std")
-        err = abs(r["fn_dev_pct"] / sd) if sd not in (None, 0) and np.isfinite(sd) else None
-        ax.bar(f"{r['fn_predicted_hz']:.4g} Hz", r["fn_dev_pct"], color=colors[r["verdict"]], yerr=err, capsize=3)
-    ax.axhline(0, color="k", lw=0.6)
-    for sgn in (-1, 1):
-        ax.axhline(sgn * rtol_fn * 100, color="C3", ls="--", lw=0.8)
-    ax.set_ylabel("fn deviation [%]")
-    ax.set_xlabel("predicted mode")
-    ax.set_title(f"measured vs {against}: {cmp.verdict}", fontsize=9)
+        _, (ax, ax_z) = plt.subplots(1, 2, figsize=(10, 4), width_ratios=(3, 2))
+    colors = {"ok": COLORS["ok"], "watch": COLORS["watch"], "alarm": COLORS["alarm"]}
+    labels = [f"{r['fn_predicted_hz']:.4g} Hz" for r in cmp.rows]
+
+    def bars(axis, key, tol, what):
+        for lab, r in zip(labels, cmp.rows):
+            dev, sd = r.get(f"{key}_dev_pct"), r.get(f"{key}_dev_std")
+            if dev is None or not np.isfinite(dev):
+                axis.bar(lab, 0.0, color="none", edgecolor="0.6", hatch="//")
+                continue
+            err = abs(dev / sd) if sd not in (None, 0) and np.isfinite(sd) else None
+            axis.bar(lab, dev, color=colors[r["verdict"]], yerr=err, capsize=3)
+        axis.axhline(0, color="k", lw=0.6)
+        for sgn in (-1, 1):
+            axis.axhline(sgn * tol * 100, color=COLORS["alarm"], ls="--", lw=0.8)
+        axis.set_ylabel(f"{what} deviation [%]")
+        axis.set_xlabel("predicted mode")
+    bars(ax, "fn", rtol_fn, "fn")
+    ax.set_title(f"measured vs {against}: {cmp.verdict} (bars: one std; dashed: tolerance)")
+    if ax_z is not None:
+        bars(ax_z, "zeta", rtol_zeta, "zeta")
+        ax_z.set_title("damping ratio")
     return ax
 
 
