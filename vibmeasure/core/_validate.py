@@ -100,7 +100,7 @@ def check_range(data, *, what: str = "rec") -> None:
     a = np.asarray(data)
     if a.size == 0 or a.dtype.kind not in "fc":
         return
-    m = float(np.max(np.abs(a)))
+    m = max(float(np.max(a.real)), -float(np.min(a.real))) if a.dtype.kind == "f" else float(np.max(np.abs(a)))
     if m > RANGE[1] or 0 < m < RANGE[0]:
         raise ParameterError(f"{what} peaks at {m:.3g}: outside {RANGE[0]:g}..{RANGE[1]:g}, where its power would "
                              "overflow or underflow double precision; rescale it (choose another unit)")

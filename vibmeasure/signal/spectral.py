@@ -1,14 +1,17 @@
 """Amplitude-correct spectra, PSD, CSD, coherence, spectrogram, band and octave RMS.
 
 All segment-averaged estimates reduce to one blocked engine (:func:`_segment_sums`): segments are
-taken as strided views, detrended, windowed and transformed 64 at a time (cache-sized batches),
-and their power or cross products are summed. The same engine streams a
+taken as strided views, windowed and transformed 32 at a time (cache-sized batches, shared between
+the calling thread and one worker), and their power or cross products are summed. For windows
+whose DFT has a few lines only (the cosine-sum family: Hann, Hamming, Blackman, flat-top, boxcar)
+the constant detrend is applied to those lines of the transform (linearity), not to every sample. The same engine streams a
 :class:`~vibmeasure.io.LazyRecord` from disk in bounded blocks, so a recording larger than memory
 is handled like one in memory. Results equal ``scipy.signal.welch``/``csd`` to round-off.
 """
 
 from __future__ import annotations
 
+import functools
 from typing import Callable
 
 import numpy as np
@@ -63,10 +66,24 @@ def get_window(window, n: int) -> np.ndarray:
             raise ParameterError(f"window array has shape {window.shape}; it must have nperseg={n} values")
         return window.astype(float)
     try:
-        return _sig.get_window(window, n, fftbins=True)
+        return _named_window(window, int(n)).copy()
     except (ValueError, TypeError) as exc:
         raise ParameterError(f"window={window!r} is not a known window ({exc}); e.g. 'hann', 'hamming', "
                              "'flattop', 'boxcar', ('kaiser', 8.0)") from None
+
+
+@functools.lru_cache(maxsize=32)
+def _named_window(window, n: int) -> np.ndarray:
+    return _sig.get_window(window, n, fftbins=True)
+
+
+@functools.lru_cache(maxsize=32)
+def _window_lines(key: bytes, nperseg: int, nfft: int):
+    """The DFT lines of a window (padded to nfft) that are not zero: (indices, values)."""
+    win = np.frombuffer(key, float)
+    W = _fft.rfft(np.r_[win, np.zeros(nfft - nperseg)])
+    lines = np.flatnonzero(np.abs(W) > 1e-12 * np.abs(W).max())
+    return lines, W[lines]
 
 
 def _check_dtype(dtype):
@@ -142,32 +159,55 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
     win = win.astype(dtype)  # float32 segments stay float32 through the FFT (sums are kept in float64)
     names = [c.name for c in src.channels]
     all_rows = list(idx) == list(range(src.n_channels))
+    # A cosine-sum window (Hann, Hamming, Blackman, flat-top, boxcar) has a DFT with a few lines only:
+    # removing a segment's mean m then changes only those lines, by m W[k] (linearity), so the
+    # constant detrend costs a sum per segment instead of a pass over every sample.
+    lines, W_lines = _window_lines(np.ascontiguousarray(win, float).tobytes(), nperseg, nfft)
+    sparse = detrend == "constant" and lines.size <= 8
+    W_lines = W_lines.astype(np.complex64 if dtype == np.float32 else complex)
 
-    def work(segs, lo, hi, s0):
-        au = np.zeros((n_ch, nf)) if reducer == "sum" else np.full((n_ch, nf), -np.inf)
+    def work(segs, chunks, s0):
+        """Sums over the segment batches this thread takes from the shared chunk iterator."""
+        au = np.zeros((n_ch, 2 * nf)) if reducer == "sum" else np.full((n_ch, nf), -np.inf)
         cr = np.zeros((len(pairs), nf), complex)
-        for b0 in range(lo, hi, BATCH):
-            b1 = min(hi, b0 + BATCH)
+        buf = np.empty((BATCH, nperseg), dtype)           # one windowed batch, reused (no allocation per batch)
+        pad = np.zeros((BATCH, nfft), dtype) if nfft > nperseg else None
+        for b0, b1 in chunks:   # list iterators hand out each chunk once, also across threads (GIL)
             Xs = []
+            m = b1 - b0
             for c in range(n_ch):
                 y = segs[c, b0:b1]
-                if detrend == "constant":
-                    y = y - y.mean(axis=-1, keepdims=True)
-                elif detrend == "linear":
-                    y = y - y.mean(axis=-1, keepdims=True)
-                    y = y - (y @ tt)[:, None] * tt
-                X = _fft.rfft(y * win, n=nfft, axis=-1)
-                P = X.real ** 2 + X.imag ** 2
-                if keep_segments:
-                    per_seg[c, s0 + b0:s0 + b1] = P
-                if reducer == "sum":
-                    au[c] += P.sum(axis=0)
-                else:
-                    np.maximum(au[c], P.max(axis=0), out=au[c])
+                if not sparse:
+                    if detrend == "constant":
+                        y = y - y.mean(axis=-1, keepdims=True)
+                    elif detrend == "linear":
+                        y = y - y.mean(axis=-1, keepdims=True)
+                        y = y - (y @ tt)[:, None] * tt
+                yw = np.multiply(y, win, out=buf[:m])
+                if pad is not None:
+                    pad[:m, :nperseg] = yw
+                    yw = pad[:m]
+                X = _fft.rfft(yw, axis=-1)
+                if sparse:
+                    X[:, lines] -= (y.sum(axis=-1) / nperseg)[:, None] * W_lines
                 if pairs:
-                    Xs.append(X)
+                    Xs.append(X.copy() if reducer == "sum" and not keep_segments else X)
+                if reducer == "sum" and not keep_segments:
+                    v = X.view(X.real.dtype).reshape(m, 2 * nf)   # re, im interleaved, squared in place
+                    np.square(v, out=v)
+                    au[c] += v.sum(axis=0, dtype=float)
+                else:
+                    P = X.real ** 2 + X.imag ** 2
+                    if keep_segments:
+                        per_seg[c, s0 + b0:s0 + b1] = P
+                    if reducer == "sum":
+                        au[c, :nf] += P.sum(axis=0)
+                    else:
+                        np.maximum(au[c], P.max(axis=0), out=au[c])
             for k, (i, j) in enumerate(pairs):
                 cr[k] += (Xs[i] * Xs[j].conj()).sum(axis=0)
+        if reducer == "sum":
+            au = au.reshape(n_ch, nf, 2).sum(axis=2) if not keep_segments else au[:, :nf]
         return au, cr
 
     autos = np.zeros((n_ch, nf)) if reducer == "sum" else np.full((n_ch, nf), -np.inf)
@@ -181,26 +221,31 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
             block = block[idx]
         if block.dtype != dtype:
             block = block.astype(dtype)
-        if not np.isfinite(block).all():
-            bad = np.argwhere(~np.isfinite(block))[0]
-            raise ParameterError(f"channel {names[idx[bad[0]]]!r} has NaN/inf at sample {a0 + bad[1]}; the rule is "
-                                 "finite data: repair or cut the record first")
         segs = np.lib.stride_tricks.as_strided(
             block, shape=(n_ch, s1 - s0, nperseg),
             strides=(block.strides[0], block.strides[1] * step, block.strides[1]), writeable=False)
         m = s1 - s0
+        chunks = iter([(b, min(m, b + BATCH)) for b in range(0, m, BATCH)])
         if pool is None or m < 2 * BATCH:
-            parts = [work(segs, 0, m, s0)]
-        else:
-            cut = (m // 2 // BATCH) * BATCH
-            futs = [pool.submit(work, segs, 0, cut, s0), pool.submit(work, segs, cut, m, s0)]
-            parts = [f.result() for f in futs]
+            parts = [work(segs, chunks, s0)]
+        else:  # this thread works too, and takes more batches when the other core is slow to start
+            fut = pool.submit(work, segs, chunks, s0)
+            parts = [work(segs, chunks, s0), fut.result()]
         for au, cr in parts:
             if reducer == "sum":
                 autos += au
             else:
                 np.maximum(autos, au, out=autos)
             crosses += cr
+        # a NaN or inf sample anywhere in a segment reaches every line of that segment's power (no
+        # separate pass over the data); only then is the block searched for the first bad sample
+        if not (np.isfinite(autos[:, 0]).all() and np.isfinite(autos[:, nf // 2]).all()) or \
+                (per_seg is not None and not np.isfinite(per_seg[:, s0:s1, 0]).all()):
+            bad = np.argwhere(~np.isfinite(block))
+            if bad.size:
+                bad = bad[0]
+                raise ParameterError(f"channel {names[idx[bad[0]]]!r} has NaN/inf at sample {a0 + bad[1]}; the rule "
+                                     "is finite data: repair or cut the record first")
         if progress is not None:
             progress(s1 / nseg)
     return autos, crosses, nseg, per_seg
