@@ -1,4 +1,5 @@
 """fit_modes, half-power, circle fit and MAC against analytic FRFs and the FRF-domain Cramer-Rao bound."""
+import re
 import warnings
 
 import numpy as np
@@ -207,9 +208,37 @@ def test_case2_spurious_pole_is_refused_with_its_test(shared_data):
     rec = vm.read(shared_data("impact/case2.mat"))
     rec = rec.replace(channels=(vm.Channel("Time_chan_1", "force"), vm.Channel("Time_chan_2")))
     frf = vm.estimate_frf(rec, input="Time_chan_1", nperseg=512)
-    with pytest.raises(vm.FitError, match=r"no mode in band=\(150.0, 250.0\) that the data supports: 19[0-9.]+ Hz: "
-                                          r"amplitude not significant: Wald"):
+    # the band holds no resonance: the pole either never stabilises (its appearance in the diagram turns
+    # on round-off: FRFs equal to 7e-13 take either route) or is refused by its Wald test; nothing is reported
+    with pytest.raises(vm.FitError) as info:
         vm.fit_modes(frf, band=(150, 250))
+    msg = str(info.value)
+    assert "no stable mode in band=(150.0, 250.0)" in msg or re.search(
+        r"no mode in band=\(150.0, 250.0\) that the data supports: 19[0-9.]+ Hz: amplitude not significant: Wald", msg)
+
+
+def test_wald_screen_refuses_a_pole_whose_residue_is_noise_and_keeps_a_real_one():
+    # two poles polished on a noisy FRF (0.3 % of the peak, complex Gaussian): the 90 Hz mode with a residue
+    # 1e-5 of the first is below the noise: its Wald statistic stays under the chi-square(2) level for a
+    # 1 % false alarm over the band's lines (Bonferroni) and it is refused with the statistic named; with a
+    # residue of 0.3 it is kept (reason: the test must separate "weak" from "not there")
+    from vibmeasure.identify import modal as M
+    freq = np.arange(0.25, 150, 0.25)
+    w = 2 * np.pi * freq
+    fn, zeta = np.array([30.0, 90.0]), np.array([0.02, 0.02])
+    lam0 = -zeta * 2 * np.pi * fn + 1j * 2 * np.pi * fn * np.sqrt(1 - zeta ** 2)
+    for amp2, refused in ((1e-5, [1]), (0.3, [])):
+        H = vm.synth.modal_frf(freq, fn=fn, zeta=zeta, shapes=[[1.0, amp2]]).h[:, 0, :]
+        s = 0.003 * np.abs(H).max()
+        rng = np.random.default_rng(3)
+        Hn = H + s * (rng.normal(size=H.shape) + 1j * rng.normal(size=H.shape)) / np.sqrt(2)
+        sw = np.array([np.sqrt(2) / s])
+        theta, coef, r = M._polish(w, Hn, lam0, sw)
+        cov, _ = M._covariance(w, theta, coef, r, sw)
+        out = M._unsupported(theta, coef, cov, sw, None, freq.size, 1, (5, 145), 0.25)
+        assert [k for k, _ in out] == refused
+        for _, d in out:
+            assert d["reason"].startswith("amplitude not significant: Wald") and d["wald"] < 22.0
 
 
 def test_low_coherence_is_flagged():
