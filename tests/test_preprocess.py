@@ -13,13 +13,15 @@ def accel(n=10000, f=10.0, unit="m/s^2", a=1.0):
 
 
 def test_frequency_domain_integration_of_a_sine():
-    # 1 m/s^2 at 10 Hz -> 1/(2 pi 10) m/s -> 1/(2 pi 10)^2 m, exact for whole periods
+    # 1 m/s^2 at 10 Hz -> 1/(2 pi 10) m/s -> 1/(2 pi 10)^2 m; whole periods (the
+    # extension past the ends continues the tone; its taper's leakage below the corner is 3e-9 relative):
+    # within 1e-8 of the amplitude
     v = vm.integrate(accel())
     d = vm.integrate(v)
     w = 2 * np.pi * 10.0
     t = np.arange(10000) / FS
-    np.testing.assert_allclose(v.data[0], -np.cos(w * t) / w, atol=1e-12)
-    np.testing.assert_allclose(d.data[0], -np.sin(w * t) / w ** 2, atol=1e-12)
+    np.testing.assert_allclose(v.data[0], -np.cos(w * t) / w, rtol=0, atol=1e-8 / w)
+    np.testing.assert_allclose(d.data[0], -np.sin(w * t) / w ** 2, rtol=0, atol=1e-7 / w ** 2)  # twice: 1e-7
     assert (v.channels[0].quantity, v.channels[0].unit) == ("velocity", "m/s")
     assert (d.channels[0].quantity, d.channels[0].unit) == ("displacement", "m")
     assert "integrate" in d.history[-1] and "highpass=2 Hz" in d.history[-1]
@@ -36,6 +38,49 @@ def test_time_domain_integration_of_a_sine_with_offset():
     np.testing.assert_allclose(v.data[0, mid] * w, -np.cos(w * t[mid]), atol=1e-3)
 
 
+@pytest.mark.parametrize("f0", [2.5, 3.7, 37.3, 211.9, 1000.3])
+def test_frequency_domain_integration_of_a_tone_that_is_not_periodic_in_the_record(f0):
+    # issue: 2 m/s^2 at 37.3 Hz, fs 2560 Hz, 16,384 samples gave 0.00866 m/s in the middle instead of
+    # 0.00853 (1.5 %). Target: 0.1 % in the middle 80 % for any tone above 1.25 x the corner (2 Hz);
+    # the oracle is the closed-form integral -A/w cos(w t + phi)
+    fs, n = 2560.0, 16384
+    t = np.arange(n) / fs
+    w = 2 * np.pi * f0
+    r = vm.Record.from_array(2.0 * np.sin(w * t + 0.3), fs=fs, quantity="acceleration", unit="m/s^2")
+    v = vm.integrate(r).data[0]
+    mid = slice(n // 10, n - n // 10)
+    err = np.max(np.abs(v[mid] + 2.0 / w * np.cos(w * t[mid] + 0.3))) / (2.0 / w)
+    assert err < 1e-3, err
+
+
+def test_time_domain_integration_agrees_with_the_frequency_domain_away_from_the_ends(sample_dir):
+    # issue: the README's example (machine.h5, method="time", highpass=1.0) gave a velocity RMS of
+    # 0.0144 m/s where the frequency method and the analytic 1X give 0.0030: the filters' start-up
+    # wandered through the whole 4 s record. Both now run on the record continued past its ends;
+    # target: RMS within 1 % away from the ends (the middle 80 %)
+    rec = vm.read(sample_dir / "machine.h5")
+    for hp in (1.0, 2.0):
+        f = vm.integrate(rec, highpass=hp).data[0]
+        t = vm.integrate(rec, method="time", highpass=hp).data[0]
+        mid = slice(rec.n_samples // 10, rec.n_samples - rec.n_samples // 10)
+        assert np.std(t[mid]) == pytest.approx(np.std(f[mid]), rel=0.01)
+        assert np.std(f[mid]) == pytest.approx(0.0030, rel=0.03)  # the synthetic machine's velocity RMS
+
+
+def test_the_extension_past_the_ends_continues_tones_and_never_grows():
+    # a Burg AR model is stable (|reflection| < 1): the continuation of noise decays, that of a tone goes
+    # on with its phase (checked one period past the end), and the taper brings both to zero
+    from vibmeasure.signal.preprocess import extend
+    rng = np.random.default_rng(0)
+    noise = rng.normal(size=4000)
+    e = extend(noise, 3000)
+    assert e.size == 10000 and np.max(np.abs(e[:3000])) <= np.max(np.abs(noise)) and e[0] == 0.0 == e[-1]
+    t = np.arange(4100) / 1000.0
+    tone = np.sin(2 * np.pi * 12.3 * t)
+    e = extend(tone[:4000], 1000)
+    np.testing.assert_allclose(e[5000:5100], tone[4000:4100], atol=1e-4)  # phase kept to 1e-4 rad
+
+
 def test_g_is_converted_before_integrating():
     v = vm.integrate(accel(unit="g"))
     assert np.max(np.abs(v.data[0])) == pytest.approx(9.80665 / (2 * np.pi * 10), rel=1e-6)
@@ -44,7 +89,7 @@ def test_g_is_converted_before_integrating():
 def test_differentiate_inverts_integrate():
     v = vm.integrate(accel())
     a = vm.differentiate(v)
-    np.testing.assert_allclose(a.data[0], accel().data[0], atol=1e-9)
+    np.testing.assert_allclose(a.data[0], accel().data[0], atol=1e-8)  # the taper past the ends: 3e-9
     assert a.channels[0].quantity == "acceleration"
 
 

@@ -104,11 +104,16 @@ def integrate(rec, *, method: str = "frequency", highpass: float = DEFAULT_HIGHP
               fs: float | None = None) -> Record:
     """Acceleration -> velocity, velocity -> displacement, in SI units (g becomes m/s^2 first).
 
-    ``method="frequency"``: X(f) / (i 2 pi f) with every line below ``highpass`` Hz set to zero (a
-    sine of amplitude A at f becomes A / (2 pi f), exactly for whole periods). ``method="time"``:
-    mean removed, zero-phase 4th-order Butterworth high-pass at ``highpass``, trapezoidal
-    integration, then the drift removed (linear detrend and the same high-pass). The corner (default 2 Hz) keeps low-frequency noise and sensor offset from
-    blowing up; set it below the lowest frequency of interest. Displacement cannot be integrated.
+    Both methods first remove the mean and continue the record past both ends by linear prediction
+    (a Burg AR model, then a smooth taper to zero over 32 periods of the corner), so the transform's
+    wrap-around and the filters' start-up fall outside the record. ``method="frequency"``: X(f) /
+    (i 2 pi f) with every line below ``highpass`` Hz set to zero: a sine of amplitude A at f becomes
+    A / (2 pi f) within 0.1 % in the middle 80 % of the record for any f above 1.25 x the corner,
+    whole periods or not. ``method="time"``: zero-phase 4th-order Butterworth high-pass at
+    ``highpass``, trapezoidal integration, then the drift removed (linear detrend and the same
+    high-pass); away from the ends its RMS agrees with the frequency method within 1 %. The corner
+    (default 2 Hz) keeps low-frequency noise and sensor offset from blowing up; set it below the
+    lowest frequency of interest. Displacement cannot be integrated.
     """
     return _calculus(rec, +1, method, highpass, channels, fs)
 
@@ -118,6 +123,57 @@ def differentiate(rec, *, method: str = "frequency", channels=None, fs: float | 
     """Displacement -> velocity, velocity -> acceleration, in SI units (frequency domain: X(f) i 2 pi f,
     or central differences with ``method="time"``)."""
     return _calculus(rec, -1, method, 0.0, channels, fs)
+
+
+EXTEND_ORDER = 32        # AR order of the linear-prediction extension: 16 sinusoids continued across the ends
+EXTEND_CORNER_PERIODS = 32  # extension length in periods of the high-pass corner: the taper's spread stays below it
+
+
+def burg(x: np.ndarray, order: int) -> np.ndarray:
+    """AR coefficients a (a[0] = 1; x[n] = -sum a[k] x[n-k] + e[n]) by Burg's method: the reflection
+    coefficients minimise the forward and backward prediction errors together, so |k| < 1 and the
+    model is stable (its extrapolation never grows)."""
+    f = np.array(x, float)
+    b = f.copy()
+    a = np.array([1.0])
+    for m in range(min(order, f.size - 2)):
+        ff, bb = f[m + 1:], b[m:-1]
+        den = ff @ ff + bb @ bb
+        if not den > 0:
+            break
+        k = -2.0 * (ff @ bb) / den
+        a = np.r_[a, 0.0]
+        a = a + k * a[::-1]
+        f[m + 1:], b[m + 1:] = ff + k * bb, bb + k * ff
+    return a
+
+
+def extend(x: np.ndarray, n_ext: int, *, order: int = EXTEND_ORDER) -> np.ndarray:
+    """x with n_ext samples added before and after: the AR (Burg) prediction continues it backwards
+    and forwards (tones go on with their phase), then a Planck taper (smooth to all orders, so its
+    spectrum falls faster than any power) brings it to zero.
+    Transforms and filters of the extended signal have their wrap-around and start-up at its far
+    ends, not in the record."""
+    x = np.asarray(x, float)
+    if n_ext <= 0 or x.size < 4:
+        return x.copy()
+    a = burg(x, order)
+
+    def forward(y):
+        zi = _sig.lfiltic([1.0], a, y[::-1][:a.size - 1])
+        return _sig.lfilter([1.0], a, np.zeros(n_ext), zi=zi)[0]
+    u = np.arange(1, n_ext + 1) / n_ext   # Planck taper: 1 at the record, 0 at the far end, smooth to all orders
+    with np.errstate(over="ignore", divide="ignore"):
+        taper = np.where(u < 1, 1.0 / (1.0 + np.exp(np.clip(1.0 / np.maximum(1 - u, 1e-300) - 1.0 / u, -700, 700))),
+                         0.0)
+    return np.concatenate([(forward(x[::-1]) * taper)[::-1], x, forward(x) * taper])
+
+
+def _extension_length(n: int, fs: float, highpass: float) -> int:
+    """Samples added at each end: 32 periods of the corner (so a tone just above it keeps 0.1 %), at
+    least a quarter of the record, at most four records."""
+    want = EXTEND_CORNER_PERIODS * fs / highpass if highpass > 0 else 0
+    return int(min(4 * n, max(n // 4, want)))
 
 
 def _calculus(rec, direction, method, highpass, channels, fs):
@@ -132,31 +188,35 @@ def _calculus(rec, direction, method, highpass, channels, fs):
     idx = range(rec.n_channels) if channels is None else [rec.index(c) for c in (
         [channels] if isinstance(channels, (str, int)) else channels)]
     _finite(rec, "integrate" if direction > 0 else "differentiate")
+    import scipy.fft as _fft
     data = np.array(rec.data)
     chans = list(rec.channels)
     n = rec.n_samples
-    f = np.fft.rfftfreq(n, 1 / rec.fs)
+    L = _extension_length(n, rec.fs, hp) if direction > 0 else 0
     for i in idx:
         x, c = _si(rec, i)
         q_new = _units.integral_quantity(c.quantity) if direction > 0 else _units.derivative_quantity(c.quantity)
+        if direction > 0:   # the offset first (integrated, it is a ramp); then the record continued past its ends
+            x = extend(x - x.mean(), L)
         if method == "frequency":
-            X = np.fft.rfft(x)
+            N = _fft.next_fast_len(x.size, real=True) if direction > 0 else x.size
+            f = np.fft.rfftfreq(N, 1 / rec.fs)
+            X = _fft.rfft(x, N)
             jw = 2j * np.pi * f
             if direction > 0:
                 with np.errstate(divide="ignore", invalid="ignore"):
                     Y = np.where(f >= max(hp, f[1] if f.size > 1 else 0.0), X / jw, 0.0)
             else:
                 Y = X * jw
-            y = np.fft.irfft(Y, n)
+            y = _fft.irfft(Y, N)[L:L + n]
         elif direction > 0:
             from scipy.integrate import cumulative_trapezoid
-            xx = x - x.mean()  # the offset first: integrated, it is the ramp that dominates the blow-up
             sos = _sig.butter(4, hp, btype="highpass", fs=rec.fs, output="sos") if hp > 0 else None
-            if sos is not None:
-                xx = _sig.sosfiltfilt(sos, xx)
+            xx = _sig.sosfiltfilt(sos, x) if sos is not None else x
             y = _sig.detrend(cumulative_trapezoid(xx, dx=1 / rec.fs, initial=0.0), type="linear")
             if sos is not None:  # what the integration made of the residual low-frequency content
                 y = _sig.sosfiltfilt(sos, y)
+            y = y[L:L + n]
         else:
             y = np.gradient(x, 1 / rec.fs)
         data[i] = y
