@@ -53,6 +53,22 @@ def noise_std(x: np.ndarray, fs: float) -> float:
     return min(welch_std, tail_std)
 
 
+def band_noise_std(x: np.ndarray, fs: float, band) -> float:
+    """Equivalent white-noise std of the noise inside a band: the median Welch level over the band's
+    lines (robust to the few lines a lightly damped mode's peak covers) as sqrt(level fs / 2). Below
+    the broadband std when the noise is coloured out of the band (machinery, impact transients)."""
+    n = x.size
+    nper = int(min(4096, max(64, 2 ** int(np.log2(max(n // 16, 64))))))
+    p = _welch_linear(x, fs, min(nper, n))
+    f = np.arange(p.size) * fs / min(nper, n)
+    sel = (f >= band[0]) & (f <= band[1])
+    if sel.sum() < 8:
+        return noise_std(x, fs)
+    k = max(1, 2 * n // nper - 1)
+    med_to_mean = (1 - 2 / (9 * k)) ** 3 if k > 1 else np.log(2)
+    return float(np.sqrt(np.median(p[sel]) / med_to_mean * fs / 2))
+
+
 def detrend_linear(x: np.ndarray) -> np.ndarray:
     """x less its least-squares straight line (closed form: no Vandermonde matrix)."""
     n = x.size

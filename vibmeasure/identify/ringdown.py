@@ -21,7 +21,7 @@ from ..core._threads import single_threaded
 from ..core._validate import as_record, check_band, check_memory, clean_signal, memory_guard, response_channel
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import FLAG_TEXT, ModalEstimate
-from ._decay import clipped_mask, cycle_peaks, decay_start, noise_std, spectral_peak, trim_to_decay
+from ._decay import band_noise_std, clipped_mask, cycle_peaks, decay_start, noise_std, spectral_peak, trim_to_decay
 from ._poles import pole_to_modal
 
 __all__ = ["ringdown", "ringdown_crb"]
@@ -412,8 +412,15 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     env_amp = np.hypot(a, b)
     decaying = sig0 > 0
     n_end = x.size
+    floor = np.full(sig0.size, noise0 or 0.0)
+    if band_asked is not None and noise0:
+        # the band's modes sink into the band's noise, not into the broadband level (which out-of-band
+        # components and coloured noise raise): they decide the span; the nuisance follows
+        inband = (np.hypot(om0, sig0) / (2 * np.pi) >= band_asked[0]) & (np.hypot(om0, sig0) / (2 * np.pi) <= band_asked[1])
+        if inband.any():
+            floor = np.where(inband, min(noise0, band_noise_std(x, fsr, band_asked)), np.inf)
     if noise0 and decaying.all():
-        t_floor = np.max(np.log(np.maximum(env_amp / (0.3 * noise0), 1.0)) / sig0)
+        t_floor = np.max(np.log(np.maximum(env_amp / (0.3 * floor), 1.0)) / sig0)
         n_end = int(min(x.size, max(np.ceil(t_floor * fsr) + 1, 64)))
         if n_end < x.size and "noise_floor" not in flags:
             flags.append("noise_floor")
