@@ -1,7 +1,7 @@
 """Amplitude-correct spectra, PSD, CSD, coherence, spectrogram, band and octave RMS.
 
 All segment-averaged estimates reduce to one blocked engine (:func:`_segment_sums`): segments are
-taken as strided views, windowed and transformed 32 at a time (cache-sized batches, shared between
+taken as strided views, windowed and transformed 16 at a time (cache-sized batches, shared between
 the calling thread and one worker), and their power or cross products are summed. For windows
 whose DFT has a few lines only (the cosine-sum family: Hann, Hamming, Blackman, flat-top, boxcar)
 the constant detrend is applied to those lines of the transform (linearity), not to every sample. The same engine streams a
@@ -26,7 +26,7 @@ from ..core.results import Spectrogram, Spectrum
 __all__ = ["amplitude_spectrum", "psd", "csd", "coherence", "spectrogram", "band_rms", "octave_bands",
            "power_unit", "get_window"]
 
-BATCH = 32              # segments per channel transformed together: fits the cache, amortises call overhead
+BATCH = 16              # segments per channel transformed together: fits the cache, amortises call overhead
 READ_SAMPLES = 1 << 21  # samples per channel read from a lazy source at a time
 MEDIAN_LIMIT = 20_000_000  # per-segment values kept for median averaging
 
@@ -165,6 +165,8 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
     lines, W_lines = _window_lines(np.ascontiguousarray(win, float).tobytes(), nperseg, nfft)
     sparse = detrend == "constant" and lines.size <= 8
     W_lines = W_lines.astype(np.complex64 if dtype == np.float32 else complex)
+    if sparse and lines.size and np.array_equal(lines, np.arange(lines[0], lines[-1] + 1)):
+        lines = slice(int(lines[0]), int(lines[-1]) + 1)   # contiguous lines: a view, not a gather
 
     def work(segs, chunks, s0):
         """Sums over the segment batches this thread takes from the shared chunk iterator."""
