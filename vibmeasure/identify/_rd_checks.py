@@ -12,11 +12,28 @@ from ._decay import cycle_peaks, noise_std, spectral_peak
 
 def _nonlinear_damping(x, fs, fd, noise, t_end):
     """Coulomb (linear envelope) and amplitude-dependent damping from the cycle amplitudes."""
+    tp, ap, cut = _regular_cycles(x, fs, fd, noise)
+    if tp.size < 8:
+        return {}
+    coul = _coulomb_envelope(x, fs, fd, noise, tp, ap, cut)
+    if coul is not None:
+        return coul
+    rows, fq = _cycle_groups(tp, ap, fd)
     out: dict = {}
+    if len(rows) >= 4 and np.isfinite(fq).all() and _frequency_moves(np.array([r[0] for r in rows]), fq):
+        out["frequency_dependent"] = True
+    if len(rows) >= 3:
+        out["zeta_vs_amplitude"] = [{"amplitude": a_, "zeta": z_} for a_, z_ in rows]
+        if _damping_moves(np.array([r[0] for r in rows]), np.array([r[1] for r in rows])):
+            out["amplitude_dependent"] = True
+    return out
+
+
+def _regular_cycles(x, fs, fd, noise):
+    """Cycle peaks above 10 x the noise, only the leading run of regular half cycles: where another
+    component (a leaked neighbour, noise) takes over, the spacing of the extremes goes astray."""
     tp, ap = cycle_peaks(x, fs, fd)
     ok = ap > 10 * noise
-    # only the leading run of regular half cycles: where another component (a leaked neighbour,
-    # noise) takes over, the spacing of the extremes goes astray
     cut = False
     if tp.size > 2:
         dt = np.diff(tp) * 2 * fd  # in half periods; a missed extreme gives 3, a phase jump 1.5
@@ -25,67 +42,71 @@ def _nonlinear_damping(x, fs, fd, noise, t_end):
         if bad.size:
             ok[bad[0] + 1:] = False
             cut = True
-    tp, ap = tp[ok], ap[ok]
-    if tp.size < 8:
-        return out
-    # exponential vs linear envelope, both fitted to the amplitudes themselves
+    return tp[ok], ap[ok], cut
+
+
+def _coulomb_envelope(x, fs, fd, noise, tp, ap, cut):
+    """Dry friction: an envelope that falls linearly (exponential and linear fits to the amplitudes
+    compared) and stops the motion: it reaches zero just after the last cycle and the mass then
+    stays put (beating of close modes also looks linear for a while, but goes on). Else None."""
     lin = np.polyfit(tp, ap, 1)
     r_lin = ap - np.polyval(lin, tp)
-    wts = ap  # log fit weighted by amplitude: least squares on the amplitudes to first order
-    ex = np.polyfit(tp, np.log(ap), 1, w=wts)
+    ex = np.polyfit(tp, np.log(ap), 1, w=ap)  # weighted by amplitude: least squares on the amplitudes
     r_exp = ap - np.exp(np.polyval(ex, tp))
     rss_lin, rss_exp = float(r_lin @ r_lin), float(r_exp @ r_exp)
     t_zero = -lin[1] / lin[0] if lin[0] < 0 else np.inf
     after = x[int(min(x.size, np.ceil((t_zero + 1.5 / fd) * fs))):]
-    # dry friction stops the motion: the linear envelope reaches zero just after the last cycle and
-    # the mass then stays put (beating of close modes also looks linear for a while, but goes on)
     stuck = (not cut and tp[-1] <= t_zero <= tp[-1] + 3 / fd and after.size >= fs / fd
              and np.std(after) < 3 * noise)
-    if stuck and rss_lin < 0.2 * rss_exp:
-        slope_std = np.sqrt(rss_lin / max(tp.size - 2, 1) / np.sum((tp - tp.mean()) ** 2))
-        out["coulomb"] = True
-        out["peak_times"] = tp
-        out["decay_per_cycle"] = float(-lin[0] / fd)
-        out["decay_per_cycle_std"] = float(slope_std / fd)
-        return out
-    # local damping over groups of cycles
+    if not (stuck and rss_lin < 0.2 * rss_exp):
+        return None
+    slope_std = np.sqrt(rss_lin / max(tp.size - 2, 1) / np.sum((tp - tp.mean()) ** 2))
+    return {"coulomb": True, "peak_times": tp, "decay_per_cycle": float(-lin[0] / fd),
+            "decay_per_cycle_std": float(slope_std / fd)}
+
+
+def _cycle_groups(tp, ap, fd):
+    """Local damping (amplitude, zeta) and frequency over groups of cycles."""
     g = max(3, tp.size // 8)
     rows, freqs = [], []
     for i in range(0, tp.size - g + 1, g):
         tt, aa = tp[i:i + g], ap[i:i + g]
-        sl = np.polyfit(tt, np.log(aa), 1)[0]
-        delta = -sl / fd
+        delta = -np.polyfit(tt, np.log(aa), 1)[0] / fd
         rows.append((float(np.exp(np.mean(np.log(aa)))), float(delta / np.sqrt(4 * np.pi ** 2 + delta ** 2))))
         # the group's own frequency: half cycles counted between its first and last extreme
         halves = np.round((tt[-1] - tt[0]) * 2 * fd)
         freqs.append(halves / (2 * (tt[-1] - tt[0])) if tt[-1] > tt[0] else np.nan)
-    fq = np.asarray(freqs)
-    if len(rows) >= 4 and np.isfinite(fq).all():
-        # frequency versus amplitude: a stiffening or softening structure chirps as it decays, and a
-        # sum of close 'modes' would mimic that; the slope on log amplitude must stand out of the
-        # groups' scatter (4 std) and move fn by more than 0.2 %
-        amp = np.array([r[0] for r in rows])
-        for X in (np.log(amp), amp ** 2):  # friction-like (log) or cubic-stiffness-like (A^2) trends
-            if np.ptp(X) <= 0:
-                continue
-            c = np.polyfit(X, fq, 1)
-            res = fq - np.polyval(c, X)
-            se = np.sqrt(res @ res / max(len(rows) - 2, 1) / np.sum((X - X.mean()) ** 2)) + 1e-300
-            if abs(c[0]) / se > 4 and abs(c[0]) * np.ptp(X) > 2e-3 * np.mean(fq):
-                out["frequency_dependent"] = True
-    if len(rows) >= 3:
-        amp_g = np.array([r[0] for r in rows])
-        z_g = np.array([r[1] for r in rows])
-        out["zeta_vs_amplitude"] = [{"amplitude": a_, "zeta": z_} for a_, z_ in rows]
-        X = np.log(amp_g)
-        if np.ptp(X) > 0:
-            c = np.polyfit(X, z_g, 1)
-            res = z_g - np.polyval(c, X)
-            se = np.sqrt(res @ res / max(len(rows) - 2, 1) / np.sum((X - X.mean()) ** 2)) + 1e-300
-            change = abs(c[0]) * np.ptp(X) / max(np.mean(np.abs(z_g)), 1e-300)
-            if abs(c[0]) / se > 4 and change > 0.2:
-                out["amplitude_dependent"] = True
-    return out
+    return rows, np.asarray(freqs)
+
+
+def _slope_significance(X, y):
+    """Slope of y on X and its standard error."""
+    c = np.polyfit(X, y, 1)
+    res = y - np.polyval(c, X)
+    se = np.sqrt(res @ res / max(X.size - 2, 1) / np.sum((X - X.mean()) ** 2)) + 1e-300
+    return c[0], se
+
+
+def _frequency_moves(amp, fq) -> bool:
+    """A stiffening or softening structure chirps as it decays (and a sum of close 'modes' would
+    mimic that): the slope of fn on log amplitude (friction-like) or on A^2 (cubic stiffness) must
+    stand out of the groups' scatter (4 std) and move fn by more than 0.2 %."""
+    for X in (np.log(amp), amp ** 2):
+        if np.ptp(X) <= 0:
+            continue
+        slope, se = _slope_significance(X, fq)
+        if abs(slope) / se > 4 and abs(slope) * np.ptp(X) > 2e-3 * np.mean(fq):
+            return True
+    return False
+
+
+def _damping_moves(amp, z) -> bool:
+    """zeta depends on amplitude: a slope on log amplitude of 4 std that changes zeta by 20 %."""
+    X = np.log(amp)
+    if np.ptp(X) <= 0:
+        return False
+    slope, se = _slope_significance(X, z)
+    return abs(slope) / se > 4 and abs(slope) * np.ptp(X) / max(np.mean(np.abs(z)), 1e-300) > 0.2
 
 
 def _dominant_cycles(x, fs):

@@ -96,22 +96,8 @@ def _lm_inner(p, x, w, t, tn, nm, max_iter):
             nu = 2.0
             if small or gain <= 1e-15 * rss:
                 break
-            # converged when the last step moved every decay rate and frequency by under 1e-3 of
-            # its std, or when the Newton decrement (what a further Gauss-Newton step could still
-            # gain) is below a millionth of one noise variance
             s2 = rss / max(x.size - p.size, 1)
-            try:
-                Ainv_d = np.diag(np.linalg.inv(A))
-                dec = float(g @ np.linalg.solve(A, g))
-            except np.linalg.LinAlgError:
-                Ainv_d, dec = np.full(p.size, np.inf), np.inf
-            # (baseline wander, under two cycles in the span, is a nuisance: its slow crawl along
-            # the valley it forms with the drift term does not move the modes)
-            osc = [k for k in range(nm) if abs(p[4 * k + 1]) * t[-1] >= 4 * np.pi]
-            nl_idx = np.r_[[4 * k for k in osc], [4 * k + 1 for k in osc]].astype(int)
-            if osc and np.all(np.abs(step[nl_idx]) < 1e-3 * np.sqrt(np.maximum(s2 * Ainv_d[nl_idx], 0))):
-                break
-            if dec < 1e-6 * s2:
+            if _converged(p, A, g, step, s2, nm, t[-1]):
                 break
             # a crawl: two accepted steps in a row each gaining under 1e-5 of a noise variance
             # move the parameters by about 3e-3 of their std
@@ -124,6 +110,23 @@ def _lm_inner(p, x, w, t, tn, nm, max_iter):
             if lam > 1e12:
                 break
     return p, rss, A
+
+
+def _converged(p, A, g, step, s2, nm, t_end) -> bool:
+    """Converged when the last step moved every decay rate and frequency by under 1e-3 of its std,
+    or when the Newton decrement (what a further Gauss-Newton step could still gain) is below a
+    millionth of one noise variance. (Baseline wander, under two cycles in the span, is a nuisance:
+    its slow crawl along the valley it forms with the drift term does not move the modes.)"""
+    try:
+        Ainv_d = np.diag(np.linalg.inv(A))
+        dec = float(g @ np.linalg.solve(A, g))
+    except np.linalg.LinAlgError:
+        Ainv_d, dec = np.full(p.size, np.inf), np.inf
+    osc = [k for k in range(nm) if abs(p[4 * k + 1]) * t_end >= 4 * np.pi]
+    nl_idx = np.r_[[4 * k for k in osc], [4 * k + 1 for k in osc]].astype(int)
+    if osc and np.all(np.abs(step[nl_idx]) < 1e-3 * np.sqrt(np.maximum(s2 * Ainv_d[nl_idx], 0))):
+        return True
+    return dec < 1e-6 * s2
 
 
 def _mode_shares(p, A, nm, t_end):
