@@ -28,6 +28,7 @@ TASKS = ("ringdown", "modes", "spectrum", "diagnose", "compare")
 MANIFEST_COLUMNS = ("file", "asset", "point", "channel", "rpm", "bearing", "model", "time")
 READABLE = (".csv", ".txt", ".h5", ".hdf5", ".wav", ".mat", ".lvm", ".uff", ".unv")
 COMMIT_EVERY = 50       # results per commit (each commit rewrites the store: see io/store.py)
+MAX_PER_TASK = 8        # inputs per Dask task at most (fewer when the batch is small: every worker keeps busy)
 COMMIT_SECONDS = 10.0
 SPECTRUM_BANDS = ((2.0, 10.0), (10.0, 1000.0), (1000.0, 10000.0))  # Hz: sub-synchronous, ISO 10816, bearing/gear
 
@@ -158,6 +159,11 @@ def _run(task, rec, item, options):
             summary["bearing_evidence"] = float(-min(lp)) if lp else 0.0
         return d.to_dict(), summary, {"rpm": float(rpm), "bearing": item.get("bearing"), "channel": d.channel}
     raise ParameterError(f"task {task!r} is not a per-file task")
+
+
+def analyse_files(items: list, tasks, options: dict | None = None) -> list:
+    """:func:`analyse_file` for each of a few inputs: one Dask task (a retried task analyses all again)."""
+    return [analyse_file(it, tasks, options) for it in items]
 
 
 def analyse_file(item: dict, tasks, options: dict | None = None) -> dict:
@@ -339,10 +345,18 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
                     take(analyse_file(it, tasks, options))
             else:
                 from distributed import as_completed
-                futs = [dask_client.submit(analyse_file, it, tasks, options, retries=2, pure=False) for it in todo]
-                for fut in as_completed(futs):
-                    take(fut.result())
-                    fut.release()
+                # a few inputs per task, one map call, results taken in batches: a task per input cost the
+                # client, which also hosts a local scheduler, 7-8 ms of CPU per input (a sixth of a core at
+                # 24 records/s on 2 cores), time the workers then lacked
+                n_w = max(1, len(dask_client.scheduler_info().get("workers", {})))
+                size = max(1, min(MAX_PER_TASK, len(todo) // (8 * n_w)))
+                chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
+                futs = dask_client.map(analyse_files, chunks, tasks=tasks, options=options, retries=2, pure=False)
+                for batch_done in as_completed(futs, with_results=True).batches():
+                    for fut, outs in batch_done:
+                        for out in outs:
+                            take(out)
+                        fut.release()
         finally:
             if cluster is not None:  # a client (and cluster) this call started is closed by it
                 dask_client.close()
@@ -378,7 +392,10 @@ def _client(client, workers, scheduler):
     # it every array above 64 kB is mapped and unmapped afresh, and the analysis of a record runs 1.5-2x
     # slower than in a plain process (measured in benchmarks/batch.py)
     one = {"OPENBLAS_NUM_THREADS": 1, "OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1}
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": one}):
+    # worker-saturation inf: every worker holds its next inputs, so it never waits idle for the
+    # scheduler (in this busy client process) between two records: 24 -> 27 records/s on 2 cores
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": one,
+                          "distributed.scheduler.worker-saturation": float("inf")}):
         cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, host="127.0.0.1",
                                dashboard_address=None)
     return Client(cluster), cluster
