@@ -27,7 +27,7 @@ __all__ = ["batch", "read_manifest", "analyse_file", "TASKS", "MANIFEST_COLUMNS"
 TASKS = ("ringdown", "modes", "spectrum", "diagnose", "compare")
 MANIFEST_COLUMNS = ("file", "asset", "point", "channel", "rpm", "bearing", "model", "time")
 READABLE = (".csv", ".txt", ".h5", ".hdf5", ".wav", ".mat", ".lvm", ".uff", ".unv")
-COMMIT_EVERY = 50       # results per commit (each commit rewrites the store: see io/store.py)
+COMMIT_EVERY = 50       # inputs per commit (each commit rewrites the store: see io/store.py)
 MAX_PER_TASK = 8        # inputs per Dask task at most (fewer when the batch is small: every worker keeps busy)
 COMMIT_SECONDS = 10.0
 SPECTRUM_BANDS = ((2.0, 10.0), (10.0, 1000.0), (1000.0, 10000.0))  # Hz: sub-synchronous, ISO 10816, bearing/gear
@@ -322,11 +322,11 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
             else:
                 todo.append(it)
         total = len(todo)
-        done = 0
+        done = committed = 0
         last_commit = _time.monotonic()
 
         def take(out):
-            nonlocal done, last_commit
+            nonlocal done, committed, last_commit
             mid = _store_one(st, out, tasks, keep_raw, options)
             err = "; ".join(f"{k}: {v}" for k, v in out["errors"].items())
             rows.append({"file": out["item"]["file"], "status": "error" if err else "done", "measurement": mid,
@@ -334,9 +334,9 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
             done += 1
             if progress is not None:
                 progress(done, total)
-            if st.pending >= COMMIT_EVERY or _time.monotonic() - last_commit > COMMIT_SECONDS:
+            if done - committed >= COMMIT_EVERY or _time.monotonic() - last_commit > COMMIT_SECONDS:
                 st.commit()
-                last_commit = _time.monotonic()
+                committed, last_commit = done, _time.monotonic()
 
         dask_client, cluster = _client(client, workers, scheduler)
         try:
