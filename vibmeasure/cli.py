@@ -101,7 +101,7 @@ def _parser() -> argparse.ArgumentParser:
         q.add_argument("--plot", metavar="OUT.png", help="write a picture (Bode + coherence, or the "
                                                          "stabilisation diagram for modes)")
 
-    from .models.loader import TOML_FORMAT
+    from .core.model_format import TOML_FORMAT
     md = sub.add_parser("model", help="predictions of a model described in a TOML file",
                         description="Natural frequencies and damping a model predicts (vm.models.load).",
                         epilog=TOML_FORMAT, formatter_class=argparse.RawDescriptionHelpFormatter)
