@@ -392,10 +392,15 @@ def _client(client, workers, scheduler):
     # it every array above 64 kB is mapped and unmapped afresh, and the analysis of a record runs 1.5-2x
     # slower than in a plain process (measured in benchmarks/batch.py)
     one = {"OPENBLAS_NUM_THREADS": 1, "OMP_NUM_THREADS": 1, "MKL_NUM_THREADS": 1}
-    # worker-saturation inf: every worker holds its next inputs, so it never waits idle for the
-    # scheduler (in this busy client process) between two records: 24 -> 27 records/s on 2 cores
+    # worker-saturation inf: every worker holds its next inputs and never waits for the scheduler (in
+    # this busy client process). The workers' own periodic duties (a stack profiler sampling every
+    # 10 ms, an event-loop tick every 20 ms, system and memory monitors) made each analysis 16 % slower
+    # than in a plain process (71.5 against 60.3 ms, measured one worker alone): they are for a
+    # dashboard this cluster does not serve, so they run rarely or not at all
+    quiet = {"distributed.worker.profile.enabled": False, "distributed.admin.tick.interval": "1s",
+             "distributed.admin.system-monitor.interval": "2s", "distributed.worker.memory.monitor-interval": "1s"}
     with dask.config.set({"distributed.nanny.pre-spawn-environ": one,
-                          "distributed.scheduler.worker-saturation": float("inf")}):
+                          "distributed.scheduler.worker-saturation": float("inf"), **quiet}):
         cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True, host="127.0.0.1",
                                dashboard_address=None)
     return Client(cluster), cluster
