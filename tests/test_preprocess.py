@@ -93,6 +93,15 @@ def test_differentiate_inverts_integrate():
     assert a.channels[0].quantity == "acceleration"
 
 
+def test_integration_of_a_record_too_short_is_a_named_error():
+    # two or three samples used to end in numpy's broadcasting and scipy's padlen errors
+    for n in (2, 3, 15):
+        r = vm.Record.from_array(np.arange(n, dtype=float), fs=100.0, quantity="acceleration", unit="m/s^2")
+        for method in ("frequency", "time"):
+            with pytest.raises(vm.ParameterError, match="needs at least 16"):
+                vm.integrate(r, method=method)
+
+
 def test_integration_refusals():
     d = vm.Record.from_array(np.sin(np.arange(100.0)), fs=FS, quantity="displacement", unit="m")
     with pytest.raises(vm.ParameterError, match="cannot be integrated"):

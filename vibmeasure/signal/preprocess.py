@@ -188,6 +188,9 @@ def _calculus(rec, direction, method, highpass, channels, fs):
     idx = range(rec.n_channels) if channels is None else [rec.index(c) for c in (
         [channels] if isinstance(channels, (str, int)) else channels)]
     _finite(rec, "integrate" if direction > 0 else "differentiate")
+    if rec.n_samples < 16:
+        raise ParameterError(f"the record has {rec.n_samples} samples; {'integration' if direction > 0 else 'differentiation'} "
+                             "needs at least 16 (the high-pass and the extension past the ends need a few cycles)")
     import scipy.fft as _fft
     data = np.array(rec.data)
     chans = list(rec.channels)

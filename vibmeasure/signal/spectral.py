@@ -248,6 +248,8 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
                 bad = bad[0]
                 raise ParameterError(f"channel {names[idx[bad[0]]]!r} has NaN/inf at sample {a0 + bad[1]}; the rule "
                                      "is finite data: repair or cut the record first")
+            raise ParameterError("the spectrum's power overflows double precision: the samples are too large for "
+                                 "this segment length; rescale the record (choose another unit)")
         if progress is not None:
             progress(s1 / nseg)
     return autos, crosses, nseg, per_seg
