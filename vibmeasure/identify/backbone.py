@@ -33,41 +33,38 @@ def _window_fit(y, t, sig, om):
     """ML fit of a*e^{-s t}cos(w t) + b*e^{-s t}sin(w t) + c on one window: (p, cov, rss) or None.
 
     Gauss-Newton on (s, w) with the linear part (a, b, c) solved exactly at each step (variable
-    projection); small normal equations throughout, a handful of iterations from the global start."""
+    projection); small normal equations throughout, a handful of iterations from the start given
+    (the previous window's solution, else the global estimate). The Jacobian rows (d/ds, d/dw, cos,
+    sin, 1) live in one array, so one product gives both the linear and the full normal equations."""
     p = np.array([sig, om, 0.0, 0.0, 0.0])
-    lin = np.zeros(3)
-    for it in range(13):
+    J = np.empty((5, t.size))
+    J[4] = 1.0
+
+    def at(p):
         e = np.exp(-p[0] * t)
-        c, s = e * np.cos(p[1] * t), e * np.sin(p[1] * t)
-        A = np.column_stack([c, s, np.ones_like(t)])
-        try:
-            lin = np.linalg.solve(A.T @ A, A.T @ y)
-        except np.linalg.LinAlgError:
-            return None
-        p[2:] = lin
-        r = y - A @ lin
-        J = np.column_stack([-t * (lin[0] * c + lin[1] * s), t * (lin[1] * c - lin[0] * s), c, s, np.ones_like(t)])
-        if it == 12:
-            break
-        try:
-            step = np.linalg.solve(J.T @ J, J.T @ r)
-        except np.linalg.LinAlgError:
-            return None
-        p[:2] += step[:2]
-        if abs(step[1]) < 1e-8 * abs(p[1]) and abs(step[0]) < 1e-8 * abs(p[1]):
-            # converged: one more pass refreshes the linear part and the Jacobian at the solution
-            e = np.exp(-p[0] * t)
-            c, s = e * np.cos(p[1] * t), e * np.sin(p[1] * t)
-            A = np.column_stack([c, s, np.ones_like(t)])
-            lin = np.linalg.solve(A.T @ A, A.T @ y)
-            p[2:] = lin
-            r = y - A @ lin
-            J = np.column_stack([-t * (lin[0] * c + lin[1] * s), t * (lin[1] * c - lin[0] * s), c, s,
-                                 np.ones_like(t)])
-            break
-    rss = float(r @ r)
+        J[2], J[3] = e * np.cos(p[1] * t), e * np.sin(p[1] * t)
+        L = J[2:]
+        lin = np.linalg.solve(L @ L.T, L @ y)
+        r = y - lin @ L
+        J[0] = -t * (lin[0] * J[2] + lin[1] * J[3])
+        J[1] = t * (lin[1] * J[2] - lin[0] * J[3])
+        return lin, r
+
     try:
-        cov = rss / max(t.size - 5, 1) * np.linalg.inv(J.T @ J)
+        for it in range(13):
+            lin, r = at(p)
+            p[2:] = lin
+            if it == 12:
+                break
+            step = np.linalg.solve(J @ J.T, J @ r)
+            p[:2] += step[:2]
+            if abs(step[1]) < 1e-8 * abs(p[1]) and abs(step[0]) < 1e-8 * abs(p[1]):
+                # converged: one more pass refreshes the linear part and the Jacobian at the solution
+                lin, r = at(p)
+                p[2:] = lin
+                break
+        rss = float(r @ r)
+        cov = rss / max(t.size - 5, 1) * np.linalg.inv(J @ J.T)
     except np.linalg.LinAlgError:
         return None
     return p, cov, rss
@@ -95,6 +92,7 @@ def backbone(x, fs: float, *, fn: float, zeta: float, noise: float, cycles: floa
     nw = int(round(per_win * fs / fn))
     step = max(nw // 2, 1)
     rows = []
+    start = (sig, om)
     for s0 in range(0, max(int(t_alive * fs) - nw + 1, 0), step):
         y = x[s0:s0 + nw]
         if y.size < nw:
@@ -102,10 +100,14 @@ def backbone(x, fs: float, *, fn: float, zeta: float, noise: float, cycles: floa
         tc = (nw - 1) / (2 * fs)
         t = np.arange(nw) / fs - tc  # centred: amplitudes refer to the window's middle
         q = max(1, nw // MAX_SAMPLES)  # every q-th sample keeps the model exact; the std says what it costs
-        out = _window_fit(y[::q], t[::q], sig, om)
+        out = _window_fit(y[::q], t[::q], *start)
+        if out is None and start != (sig, om):
+            out = _window_fit(y[::q], t[::q], sig, om)
         if out is None:
             continue
         p, cov, _ = out
+        if p[0] > 0 and abs(p[1] - om) < 0.05 * om:
+            start = (p[0], p[1])   # the next window starts where this one ended: fewer iterations
         amp = float(np.hypot(p[2], p[3]))
         amp_std = float(np.sqrt(max(cov[2, 2] + cov[3, 3], 0) / 2))
         if amp < SNR_STOP * amp_std:
