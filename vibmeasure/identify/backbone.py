@@ -41,8 +41,8 @@ def _window_fit(y, t, sig, om):
     J[4] = 1.0
 
     def at(p):
-        e = np.exp(-p[0] * t)
-        J[2], J[3] = e * np.cos(p[1] * t), e * np.sin(p[1] * t)
+        z = np.exp(complex(-p[0], p[1]) * t)   # e^{-s t} (cos w t + i sin w t): one exponential
+        J[2], J[3] = z.real, z.imag
         L = J[2:]
         lin = np.linalg.solve(L @ L.T, L @ y)
         r = y - lin @ L
