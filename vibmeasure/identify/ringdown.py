@@ -25,7 +25,7 @@ from ..core._validate import as_record, check_band, check_memory, clean_signal, 
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.record import Record
 from ..core.results import FLAG_TEXT, ModalEstimate
-from ._decay import band_noise_std, clipped_mask, decay_start, trim_to_decay
+from ._decay import band_noise_std, clipped_mask, decay_start, decimation_factor, trim_to_decay
 from ._poles import pole_to_modal
 from ._rd_checks import _amplitude_check, _coulomb_check, _dominant_cycles, _nonlinear_damping, _overdamped_try
 from ._rd_ml import (_colored_noise_scale, _evaluate, _lm, _mode_energy, _mode_model, _mode_shares,
@@ -177,46 +177,24 @@ def _prepare(rec, channel, n_modes, band, start, max_modes, fs, progress) -> _De
     return d
 
 
-DECIMATE_MIN_SAMPLES = 20_000   # shorter decays cost little at their own rate
-DECIMATE_FS_OVER_F = 20.0       # the decimated rate keeps 20 samples per cycle of the highest line
-
-
 def _decimate_oversampled(d: _Decay) -> None:
-    """A decay sampled far above its content is fitted on a decimated copy: the noise outside the
-    kept band carries no information about the modes, so the fit is as efficient and costs a fraction.
-
-    The highest line is the highest line of the Hann periodogram (the whole record) above the
-    level that white noise passes with a 1 % chance over all lines; the copy keeps ten times that
-    frequency (and the band), 20 samples per cycle of the line. Not for clipped records (a filter
-    smears the clipping into its neighbours). The filter's first samples (its start-up on the decay's
-    abrupt start) are left out, and the decay start moves with them."""
+    """A decay sampled far above its content is fitted on a decimated copy (see
+    :func:`._decay.decimation_factor`): the noise outside the kept band carries no information about
+    the modes, so the fit is as efficient and costs a fraction. The filter's first samples (its
+    start-up on the decay's abrupt start) are left out, and the decay start moves with them."""
     from scipy import signal as _sig
-    x, fs = d.x, d.fsr
-    if x.size < DECIMATE_MIN_SAMPLES or d.clip.any():
+    if d.clip.any():   # a filter smears the clipping into its neighbours
         return
-    # Hann-tapered: the sidelobes of a strong line (and of the decay's abrupt start and end) fall as
-    # 1/f^6 instead of 1/f^2, so they do not pass for content far from it. The periodic Hann window
-    # is a three-line convolution of the transform (0.5 X[k] - 0.25 X[k-1] - 0.25 X[k+1]); the lines
-    # below two cycles in the record, where the mean would show, are not searched
-    import scipy.fft as _fft
-    X = _fft.rfft(x)
-    P = np.abs(0.5 * X[1:-1] - 0.25 * (X[:-2] + X[2:])) ** 2
-    f = np.arange(1, P.size + 1) * fs / x.size
-    level = np.median(P[1:]) / np.log(2) * np.log(P.size / 0.01)
-    strong = f[(P > level) & (f > 2 * fs / x.size)]
-    f_top = max(float(strong.max()) if strong.size else 0.0, d.band[1] if d.band else 0.0)
-    if f_top <= 0:
-        return
-    q = int(fs / (DECIMATE_FS_OVER_F * f_top))
+    q, f_top = decimation_factor(d.x, d.fsr, d.band)
     if q < 2:
         return
-    y = _sig.resample_poly(x, 1, q)
+    y = _sig.resample_poly(d.x, 1, q)
     skip = 10 + 1   # resample_poly's filter spans 10 output samples each side: its start-up
     d.x = y[skip:-skip]
     d.w = np.ones(d.x.size)
     d.clip = np.zeros(d.x.size, bool)
     d.i0 += skip * q
-    d.fsr = fs / q
+    d.fsr = d.fsr / q
     d.decimation = q
     d.notes.append(f"fitted on every {q}th sample after an anti-alias filter (content below {f_top:.4g} Hz; "
                    f"the decimated rate {d.fsr:.4g} Hz keeps 20 samples per cycle)")
