@@ -70,6 +70,62 @@ def _window_fit(y, t, sig, om):
     return p, cov, rss
 
 
+BATCH_WINDOWS = 64   # windows fitted together (vectorised Gauss-Newton), bounded memory
+
+
+def _windows_fit(x, starts, nw, q, t, sig, om):
+    """_window_fit for every window at once, BATCH_WINDOWS at a time: the same variable-projection
+    Gauss-Newton from the global start, each window stopping when its step is below 1e-8 of w (then
+    refreshed at its solution), at most 12 steps. (p, cov) per window; None where a fit fails (a
+    batch with a singular system is done window by window)."""
+    from numpy.lib.stride_tricks import sliding_window_view
+    if starts.size == 0 or nw > x.size:
+        return []
+    view = sliding_window_view(x, nw)
+    out = []
+    for b0 in range(0, starts.size, BATCH_WINDOWS):
+        Y = view[starts[b0:b0 + BATCH_WINDOWS]][:, ::q]
+        try:
+            out += _batch_fit(Y, t, sig, om)
+        except np.linalg.LinAlgError:
+            for y in Y:
+                res = _window_fit(y, t, sig, om)
+                out.append(None if res is None else res[:2])
+    return out
+
+
+def _batch_fit(Y, t, sig, om):
+    m = Y.shape[0]
+    p = np.tile([sig, om, 0.0, 0.0, 0.0], (m, 1))
+    J = np.empty((m, 5, t.size))
+    J[:, 4] = 1.0
+
+    def at(p):
+        z = np.exp((-p[:, :1] + 1j * p[:, 1:2]) * t)
+        J[:, 2], J[:, 3] = z.real, z.imag
+        L = J[:, 2:]
+        lin = np.linalg.solve(L @ L.transpose(0, 2, 1), (L @ Y[:, :, None]))[:, :, 0]
+        r = Y - np.einsum("wk,wkn->wn", lin, L)
+        J[:, 0] = -t * (lin[:, :1] * J[:, 2] + lin[:, 1:2] * J[:, 3])
+        J[:, 1] = t * (lin[:, 1:2] * J[:, 2] - lin[:, :1] * J[:, 3])
+        return lin, r
+
+    active = np.ones(m, bool)
+    for _ in range(12):
+        lin, r = at(p)
+        step = np.linalg.solve(J @ J.transpose(0, 2, 1), (J @ r[:, :, None]))[:, :, 0]
+        p[active, :2] += step[active, :2]
+        done = (np.abs(step[:, 1]) < 1e-8 * np.abs(p[:, 1])) & (np.abs(step[:, 0]) < 1e-8 * np.abs(p[:, 1]))
+        active &= ~done
+        if not active.any():
+            break
+    lin, r = at(p)   # the linear part and the Jacobian at the solution
+    p[:, 2:] = lin
+    rss = np.einsum("wn,wn->w", r, r)
+    cov = rss[:, None, None] / max(t.size - 5, 1) * np.linalg.inv(J @ J.transpose(0, 2, 1))
+    return [(p[k].copy(), cov[k]) for k in range(m)]
+
+
 def backbone(x, fs: float, *, fn: float, zeta: float, noise: float, cycles: float | None = None):
     """fn and zeta versus amplitude of a one-mode decay ``x`` (the mode isolated: other modes and
     offsets removed), from ML fits on half-overlapping windows. Returns a DataFrame with t_s,
@@ -92,22 +148,16 @@ def backbone(x, fs: float, *, fn: float, zeta: float, noise: float, cycles: floa
     nw = int(round(per_win * fs / fn))
     step = max(nw // 2, 1)
     rows = []
-    start = (sig, om)
-    for s0 in range(0, max(int(t_alive * fs) - nw + 1, 0), step):
-        y = x[s0:s0 + nw]
-        if y.size < nw:
-            break
-        tc = (nw - 1) / (2 * fs)
-        t = np.arange(nw) / fs - tc  # centred: amplitudes refer to the window's middle
-        q = max(1, nw // MAX_SAMPLES)  # every q-th sample keeps the model exact; the std says what it costs
-        out = _window_fit(y[::q], t[::q], *start)
-        if out is None and start != (sig, om):
-            out = _window_fit(y[::q], t[::q], sig, om)
+    starts = np.arange(0, max(int(t_alive * fs) - nw + 1, 0), step)
+    starts = starts[starts + nw <= x.size]
+    tc = (nw - 1) / (2 * fs)
+    q = max(1, nw // MAX_SAMPLES)  # every q-th sample keeps the model exact; the std says what it costs
+    t = (np.arange(nw) / fs - tc)[::q]  # centred: amplitudes refer to the window's middle
+    fits = _windows_fit(x, starts, nw, q, t, sig, om)
+    for s0, out in zip(starts, fits):
         if out is None:
             continue
-        p, cov, _ = out
-        if p[0] > 0 and abs(p[1] - om) < 0.05 * om:
-            start = (p[0], p[1])   # the next window starts where this one ended: fewer iterations
+        p, cov = out
         amp = float(np.hypot(p[2], p[3]))
         amp_std = float(np.sqrt(max(cov[2, 2] + cov[3, 3], 0) / 2))
         if amp < SNR_STOP * amp_std:
