@@ -220,9 +220,34 @@ def impact_frf(rec, *, input="force", outputs=None, record_length: float | None 
     ii, oo = _io(rec, input, outputs)
     if len(ii) != 1:
         raise ParameterError("impact_frf takes one force input (the hammer)")
-    fsr = rec.fs
     force = rec.data[ii[0]]
-    hits = find_hits(force, fsr, threshold=threshold)
+    hits = find_hits(force, rec.fs, threshold=threshold)
+    pre = _check_impact(rec, force, hits, pretrigger, threshold)
+    starts, n = _hit_records(rec, hits, pre, record_length)
+    tau, ew = _exponential_window(n, pre, rec.fs, exp_window)
+    sums, double, clipped = _hit_sums(rec, force, ii[0], oo, starts, n, pre, ew, force_window)
+    flags = (["double_hit"] if double else []) + (["clipped"] if clipped else [])
+    H, coh = _h_from_sums(sums[0][None, None].astype(complex), sums[1][:, None], sums[2], estimator, 1)
+    navg = starts.size
+    if navg < 2:
+        coh = np.ones_like(coh)  # a single hit gives no coherence estimate
+        flags.append("single_average")
+    outs = [rec.channels[i] for i in oo]
+    forms = {form_of(c.quantity) for c in outs}
+    err = np.broadcast_to(_random_error(coh, navg)[:, None, :], H.shape).copy()
+    frf = FRF(np.fft.rfftfreq(n, 1 / rec.fs), H, forms.pop() if len(forms) == 1 else "unknown", coh, estimator,
+              tuple(c.name for c in outs), (rec.channels[ii[0]].name,), _frf_unit(outs, rec.channels[ii[0]]), err,
+              {"window": "force+exponential" if tau else ("force" if force_window else "boxcar"), "nperseg": n,
+               "n_averages": int(navg), "fs": rec.fs, "exp_window_tau_s": tau, "hits_s": (starts + pre) / rec.fs,
+               "double_hits": double, "flags": tuple(flags)})
+    if flags and flags != ["single_average"]:
+        warn_quality(f"impact_frf: {', '.join(flags)}" + (f" (hits {double})" if double else ""), stacklevel=3)
+    return frf
+
+
+def _check_impact(rec, force, hits, pretrigger, threshold) -> int:
+    """The pre-trigger in samples, after the checks: a number of seconds under half the record, and a
+    force that is a train of short pulses (not continuous excitation)."""
     try:
         pretrigger = float(pretrigger)
     except (TypeError, ValueError):
@@ -235,35 +260,42 @@ def impact_frf(rec, *, input="force", outputs=None, record_length: float | None 
         raise ParameterError(f"not an impact test: the force exceeds {threshold:.0%} of its peak in {busy:.0%} of the "
                              f"samples, where hammer pulses last a few ms per hit (at most {MAX_BUSY:.0%}); for "
                              "continuous (shaker, random) excitation use vm.estimate_frf")
-    pre = int(round(pretrigger * fsr))
-    pre = min(pre, int(hits[0]))  # a hit at the very start leaves less pre-trigger
+    pre = int(round(pretrigger * rec.fs))
+    return min(pre, int(hits[0]))  # a hit at the very start leaves less pre-trigger
+
+
+def _hit_records(rec, hits, pre, record_length):
+    """Start samples of the hits' records and their length n (default: the shortest spacing)."""
     spacing = np.diff(hits)
     if record_length is None:
         n = int(spacing.min()) if spacing.size else rec.n_samples - (hits[0] - pre)
     else:
-        n = int(round(record_length * fsr))
+        n = int(round(record_length * rec.fs))
     starts = hits - pre
-    ok = (starts >= 0) & (starts + n <= rec.n_samples)
-    starts = starts[ok]
+    starts = starts[(starts >= 0) & (starts + n <= rec.n_samples)]
     if starts.size == 0:
-        raise ParameterError(f"no hit has {n} samples after it (record_length={n / fsr:g} s): shorten it")
+        raise ParameterError(f"no hit has {n} samples after it (record_length={n / rec.fs:g} s): shorten it")
     if n < 16:
         raise ParameterError(f"record_length gives {n} samples per hit: too short")
-    t = np.arange(n) / fsr
-    flags = []
+    return starts, n
+
+
+def _exponential_window(n, pre, fs, exp_window):
+    """(tau, window): exp(-t/tau) from the hit on (1 % at the record end for "auto"), or none."""
     if exp_window is None:
-        tau = None
-        ew = np.ones(n)
-    else:
-        tau = (t[-1] / np.log(100.0)) if exp_window == "auto" else float(exp_window)
-        if not np.isfinite(tau) or tau <= 0:
-            raise ParameterError(f"exp_window={exp_window!r} must be 'auto', None or a time constant > 0 s")
-        ew = np.exp(-np.clip(t - pre / fsr, 0, None) / tau)
+        return None, np.ones(n)
+    t = np.arange(n) / fs
+    tau = (t[-1] / np.log(100.0)) if exp_window == "auto" else float(exp_window)
+    if not np.isfinite(tau) or tau <= 0:
+        raise ParameterError(f"exp_window={exp_window!r} must be 'auto', None or a time constant > 0 s")
+    return tau, np.exp(-np.clip(t - pre / fs, 0, None) / tau)
+
+
+def _hit_sums(rec, force, i_force, oo, starts, n, pre, ew, force_window):
+    """Sums over the hits of |X|^2, Y conj(X) and |Y|^2 (force and exponential windows applied),
+    the hits with a double hit, and whether any record is clipped."""
     nf = n // 2 + 1
-    n_out = len(oo)
-    Sxx = np.zeros(nf)
-    Syx = np.zeros((n_out, nf), complex)
-    Syy = np.zeros((n_out, nf))
+    Sxx, Syx, Syy = np.zeros(nf), np.zeros((len(oo), nf), complex), np.zeros((len(oo), nf))
     double, clipped = [], False
     for k, s in enumerate(starts):
         fseg = force[s:s + n] - np.median(force[s:s + max(pre, 1)]) if pre > 0 else force[s:s + n].copy()
@@ -276,7 +308,7 @@ def impact_frf(rec, *, input="force", outputs=None, record_length: float | None 
         after = a[pe + dur:]
         if after.size and after.max() > DOUBLE_HIT * a[ip]:
             double.append(k)
-        if clipped_mask(rec.data[ii[0], s:s + n]).any() or any(clipped_mask(rec.data[o, s:s + n]).any() for o in oo):
+        if clipped_mask(rec.data[i_force, s:s + n]).any() or any(clipped_mask(rec.data[o, s:s + n]).any() for o in oo):
             clipped = True
         if force_window:  # keep the pulse (and the pre-trigger), zero what follows: noise, not force
             fseg = fseg.copy()
@@ -284,28 +316,7 @@ def impact_frf(rec, *, input="force", outputs=None, record_length: float | None 
         X = np.fft.rfft(fseg * ew)
         Sxx += np.abs(X) ** 2
         for j, o in enumerate(oo):
-            yseg = rec.data[o, s:s + n] - np.mean(rec.data[o, s:s + max(pre, 1)])
-            Y = np.fft.rfft(yseg * ew)
+            Y = np.fft.rfft((rec.data[o, s:s + n] - np.mean(rec.data[o, s:s + max(pre, 1)])) * ew)
             Syx[j] += Y * X.conj()
             Syy[j] += np.abs(Y) ** 2
-    if double:
-        flags.append("double_hit")
-    if clipped:
-        flags.append("clipped")
-    navg = starts.size
-    Gxx = Sxx[None, None]
-    H, coh = _h_from_sums(Gxx.astype(complex), Syx[:, None], Syy, estimator, 1)
-    if navg < 2:
-        coh = np.ones_like(coh)  # a single hit gives no coherence estimate
-        flags.append("single_average")
-    outs = [rec.channels[i] for i in oo]
-    forms = {form_of(c.quantity) for c in outs}
-    err = np.broadcast_to(_random_error(coh, navg)[:, None, :], H.shape).copy()
-    frf = FRF(np.fft.rfftfreq(n, 1 / fsr), H, forms.pop() if len(forms) == 1 else "unknown", coh, estimator,
-              tuple(c.name for c in outs), (rec.channels[ii[0]].name,), _frf_unit(outs, rec.channels[ii[0]]), err,
-              {"window": "force+exponential" if tau else ("force" if force_window else "boxcar"), "nperseg": n,
-               "n_averages": int(navg), "fs": fsr, "exp_window_tau_s": tau, "hits_s": (starts + pre) / fsr,
-               "double_hits": double, "flags": tuple(flags)})
-    if flags and flags != ["single_average"]:
-        warn_quality(f"impact_frf: {', '.join(flags)}" + (f" (hits {double})" if double else ""), stacklevel=3)
-    return frf
+    return (Sxx, Syx, Syy), double, clipped
