@@ -147,46 +147,15 @@ def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: 
     fd0 = spectral_peak(x[skip: x.size - skip] if skip else x, fsr, band)  # without the filter's end effects
     x = x - baseline_line(x, fsr, fd0)  # offset and drift would shift the extremes in time
     noise = max(noise_std(x, fsr), 1e-9 * float(np.max(np.abs(x))))
-    tp, ap = cycle_peaks(x, fsr, fd0)
-    keep = (tp >= skip / fsr) & (tp <= (x.size - skip) / fsr)
-    tp, ap = tp[keep], ap[keep]
-    # amplitudes two half-cycles apart (peaks, or troughs) share no extreme except at the ends
-    h = np.round((tp - tp[0]) * 2 * fd0).astype(int) if tp.size else np.empty(0, int)
-    par = h % 2 == 0
-    tp, ap = tp[par], ap[par]
-    below = np.flatnonzero(ap <= PEAK_SNR * noise)
-    if below.size:
-        flags.append("noise_floor")
-        tp, ap = tp[:below[0]], ap[:below[0]]
+    tp, ap = _same_sign_peaks(x, fsr, fd0, skip, noise, flags)
     m = tp.size
     need = 3 if n is None else n + 2
     if m < need:
         raise FitError(f"log_decrement: {m} cycle(s) above {PEAK_SNR:g}x the noise; at least {need} are needed")
     if m < 5:
         flags.append("few_cycles")
-    # cycle numbers from the times (robust to a missed extreme), then the period as the slope
-    k = np.round((tp - tp[0]) * fd0).astype(float)
-    Td, t_icpt = np.polyfit(k, tp, 1)
-    rt = tp - (Td * k + t_icpt)
-    Td_std = np.sqrt(rt @ rt / max(m - 2, 1) / np.sum((k - k.mean()) ** 2)) if m > 2 else np.nan
-    if n is None:
-        wts = ap ** 2
-        W = wts.sum()
-        tbar = (wts * tp).sum() / W
-        y = np.log(ap)
-        ybar = (wts * y).sum() / W
-        sxx = (wts * (tp - tbar) ** 2).sum()
-        slope = (wts * (tp - tbar) * (y - ybar)).sum() / sxx
-        res = y - (ybar + slope * (tp - tbar))
-        s2 = (wts * res ** 2).sum() / max(m - 2, 1)
-        sigma, sigma_std = -slope, np.sqrt(s2 / sxx) if m > 2 else np.nan
-        delta = sigma * Td
-        delta_std = np.hypot(sigma_std * Td, sigma * Td_std)
-    else:
-        d = np.log(ap[:-n] / ap[n:]) / n
-        delta = float(d.mean())
-        # pairs sharing cycles are correlated: about m/n independent ones
-        delta_std = float(d.std(ddof=1) / np.sqrt(max(d.size / n, 1))) if d.size > 1 else np.nan
+    Td, Td_std = _period(tp, fd0)
+    delta, delta_std = _decrement(tp, ap, Td, Td_std, n)
     zeta = float(zeta_from_delta(delta))
     dz = 4 * np.pi ** 2 / (4 * np.pi ** 2 + delta ** 2) ** 1.5
     zeta_std = float(dz * delta_std)
@@ -200,6 +169,54 @@ def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: 
     return _finish(rec, idx, "logdec", fn, zeta, fn_std, zeta_std, flags,
                    {"delta": float(delta), "delta_std": float(delta_std), "n_cycles": int(m), "cycles_apart": n,
                     "noise_std": noise, "start_s": i0 / fsr + rec.t0})
+
+
+def _same_sign_peaks(x, fs, fd0, skip, noise, flags):
+    """Cycle amplitudes two half-cycles apart (peaks, or troughs: they share no extreme except at the
+    ends), outside the filter's end effects, up to the first one below PEAK_SNR x the noise."""
+    tp, ap = cycle_peaks(x, fs, fd0)
+    keep = (tp >= skip / fs) & (tp <= (x.size - skip) / fs)
+    tp, ap = tp[keep], ap[keep]
+    h = np.round((tp - tp[0]) * 2 * fd0).astype(int) if tp.size else np.empty(0, int)
+    par = h % 2 == 0
+    tp, ap = tp[par], ap[par]
+    below = np.flatnonzero(ap <= PEAK_SNR * noise)
+    if below.size:
+        flags.append("noise_floor")
+        tp, ap = tp[:below[0]], ap[:below[0]]
+    return tp, ap
+
+
+def _period(tp, fd0):
+    """Damped period and its std: cycle numbers from the times (robust to a missed extreme), then the
+    period as the slope of time on cycle number."""
+    m = tp.size
+    k = np.round((tp - tp[0]) * fd0).astype(float)
+    Td, t_icpt = np.polyfit(k, tp, 1)
+    rt = tp - (Td * k + t_icpt)
+    Td_std = np.sqrt(rt @ rt / max(m - 2, 1) / np.sum((k - k.mean()) ** 2)) if m > 2 else np.nan
+    return Td, Td_std
+
+
+def _decrement(tp, ap, Td, Td_std, n):
+    """delta and its std: the weighted regression of ln A over all cycles (n None), or the mean of
+    ln(A_i / A_{i+n}) / n over cycles n apart."""
+    m = tp.size
+    if n is None:
+        wts = ap ** 2
+        W = wts.sum()
+        tbar = (wts * tp).sum() / W
+        y = np.log(ap)
+        ybar = (wts * y).sum() / W
+        sxx = (wts * (tp - tbar) ** 2).sum()
+        slope = (wts * (tp - tbar) * (y - ybar)).sum() / sxx
+        res = y - (ybar + slope * (tp - tbar))
+        s2 = (wts * res ** 2).sum() / max(m - 2, 1)
+        sigma, sigma_std = -slope, np.sqrt(s2 / sxx) if m > 2 else np.nan
+        return sigma * Td, np.hypot(sigma_std * Td, sigma * Td_std)
+    d = np.log(ap[:-n] / ap[n:]) / n
+    # pairs sharing cycles are correlated: about m/n independent ones
+    return float(d.mean()), float(d.std(ddof=1) / np.sqrt(max(d.size / n, 1))) if d.size > 1 else np.nan
 
 
 @memory_guard
