@@ -232,26 +232,45 @@ def hilbert_decay(rec, *, channel=None, band=None, start: float | None = None,
     """
     rec, idx, x, _, flags, i0, _ = _prepare(rec, channel, None, start, fs, trim=True, work=10)
     fsr = rec.fs
-    b0 = check_band(band, fsr)
-    fd0 = spectral_peak(x, fsr, b0)
-    if b0 is None:
-        # wide enough for the mode's own bandwidth, so the filter rings out faster than the decay
-        try:
-            f1, f2 = _halfpower_points(x, fsr, None)
-            width = max(0.3, 5 * (f2 - f1) / fd0)
-        except FitError:
-            width = 0.3
-        band = (max(fd0 * (1 - width), fd0 * 0.05), min(fd0 * (1 + width), 0.49 * fsr))
-    else:
-        band = b0
+    fd0 = spectral_peak(x, fsr, check_band(band, fsr))
+    band = _hilbert_band(x, fsr, fd0, check_band(band, fsr))
+    env, ph, t, skip = _demodulate(x, fsr, band, fd0)
+    ok = _envelope_span(x, fsr, band, env, skip, flags)
+    if int(ok.sum()) < 3 * fsr / fd0:
+        raise FitError(f"hilbert_decay: the envelope is {ENVELOPE_DB:g} dB above the noise for less than "
+                       "3 cycles after the filter's end effects")
+    wn, zeta, fn_std, zeta_std = _envelope_fit(t[ok], env[ok], ph[ok], fsr, band[1] - band[0])
+    if fsr * (t[ok][-1] - t[ok][0]) * fd0 / fsr < 5:
+        flags.append("few_cycles")
+    return _finish(rec, idx, "hilbert", wn / (2 * np.pi), zeta, fn_std, zeta_std, flags,
+                   {"band_hz": list(band), "fit_from_s": float(t[ok][0]), "fit_to_s": float(t[ok][-1]),
+                    "start_s": i0 / fsr + rec.t0})
+
+
+def _hilbert_band(x, fs, fd0, b0):
+    """The given band, or +-30 % around the strongest line, wider for a heavily damped mode (the
+    filter must ring out faster than the decay)."""
+    if b0 is not None:
+        return b0
+    try:
+        f1, f2 = _halfpower_points(x, fs, None)
+        width = max(0.3, 5 * (f2 - f1) / fd0)
+    except FitError:
+        width = 0.3
+    return (max(fd0 * (1 - width), fd0 * 0.05), min(fd0 * (1 + width), 0.49 * fs))
+
+
+def _demodulate(x, fs, band, fd0):
+    """Envelope and phase of the band's analytic signal by complex demodulation: shift the band's
+    centre to DC, zero-phase low-pass to half the band, shift back. Unlike an FFT Hilbert transform
+    this is exact for a one-sided decay once the filter's own transient has died out (no 1/t tails
+    from the abrupt start). The envelope is 2|zb| and the phase unwrap(angle(zb)) + 2 pi f0 t: the
+    shifted-back signal is never formed. Also the samples to skip at each end: the filter's slowest
+    pole must have died out (e^-7) and 3 cycles passed."""
     bw = band[1] - band[0]
     f0 = 0.5 * (band[0] + band[1])
-    # analytic signal by complex demodulation: shift f0 to DC, zero-phase low-pass to half the band,
-    # shift back. Unlike an FFT Hilbert transform this is exact for a one-sided decay once the
-    # filter's own transient has died out (no 1/t tails from the abrupt start). The envelope is
-    # 2|zb| and the phase unwrap(angle(zb)) + 2 pi f0 t: the shifted-back signal is never formed.
-    t = np.arange(x.size) / fsr
-    sos = _sig.butter(4, 0.5 * bw, btype="lowpass", fs=fsr, output="sos")
+    t = np.arange(x.size) / fs
+    sos = _sig.butter(4, 0.5 * bw, btype="lowpass", fs=fs, output="sos")
     arg = 2 * np.pi * f0 * t
     zb = _sig.sosfiltfilt(sos, x * np.cos(arg)) - 1j * _sig.sosfiltfilt(sos, x * np.sin(arg))
     env = 2 * np.abs(zb)
@@ -259,25 +278,32 @@ def hilbert_decay(rec, *, channel=None, band=None, start: float | None = None,
     del zb
     ph += arg
     del arg
-    # end effects: the filter's slowest pole must have died out (e^-7) and 3 cycles passed
-    p_filt = _sig.sos2zpk(sos)[1]
-    r_min = float(np.min(-np.log(np.abs(p_filt)))) * fsr
-    skip = int(min(x.size // 4, max(3 * fsr / fd0, 7 * fsr / r_min)))
-    # the analytic signal of a record that starts abruptly carries errors of about 1e-4 of the peak
-    noise_in_band = max(noise_std(x, fsr) * np.sqrt(2 * bw / fsr), HILBERT_FLOOR * env.max())
+    r_min = float(np.min(-np.log(np.abs(_sig.sos2zpk(sos)[1])))) * fs
+    skip = int(min(x.size // 4, max(3 * fs / fd0, 7 * fs / r_min)))
+    return env, ph, t, skip
+
+
+def _envelope_span(x, fs, band, env, skip, flags):
+    """The samples fitted: past the filter's end effects, and while the envelope stands ENVELOPE_DB
+    above the in-band noise (the analytic signal of an abrupt start carries errors of about 1e-4 of
+    the peak, HILBERT_FLOOR)."""
+    noise_in_band = max(noise_std(x, fs) * np.sqrt(2 * (band[1] - band[0]) / fs), HILBERT_FLOOR * env.max())
     ok = np.zeros(x.size, bool)
     ok[skip:x.size - skip] = True
     above = env > noise_in_band * 10 ** (ENVELOPE_DB / 20)
     if not above[skip:].all():
         flags.append("noise_floor")
-        last = skip + int(np.argmin(above[skip:]))
-        ok[last:] = False
-    m = int(ok.sum())
-    if m < 3 * fsr / fd0:
-        raise FitError(f"hilbert_decay: the envelope is {ENVELOPE_DB:g} dB above the noise for less than "
-                       "3 cycles after the filter's end effects")
-    tt, le, pp = t[ok], np.log(env[ok]), ph[ok]
-    wts = env[ok] ** 2
+        ok[skip + int(np.argmin(above[skip:])):] = False
+    return ok
+
+
+def _envelope_fit(tt, env, pp, fs, bw):
+    """Weighted least squares of the log-envelope (decay rate) and of the phase (damped frequency)
+    over time, weights env^2; stds with the samples' correlation over about fs / bw samples (the
+    factor 1.6 on that is calibrated by Monte Carlo against the observed scatter, white noise)."""
+    m = tt.size
+    le = np.log(env)
+    wts = env ** 2
     W = wts.sum()
     tbar = (wts * tt).sum() / W
     sxx = (wts * (tt - tbar) ** 2).sum()
@@ -285,9 +311,7 @@ def hilbert_decay(rec, *, channel=None, band=None, start: float | None = None,
     res = le - ((wts * le).sum() / W + sl * (tt - tbar))
     pl = (wts * (tt - tbar) * (pp - (wts * pp).sum() / W)).sum() / sxx
     resp = pp - ((wts * pp).sum() / W + pl * (tt - tbar))
-    # envelope samples are correlated over about fs / bw samples (the low-pass keeps +-bw/2); the
-    # factor 1.6 on that is calibrated by Monte Carlo against the observed scatter (white noise)
-    corr = max(1.0, 1.6 * fsr / bw)
+    corr = max(1.0, 1.6 * fs / bw)
     sig_std = np.sqrt((wts * res ** 2).sum() / max(m - 2, 1) / sxx * corr)
     om_std = np.sqrt((wts * resp ** 2).sum() / max(m - 2, 1) / sxx * corr)
     sigma, om = -sl, pl
@@ -296,11 +320,7 @@ def hilbert_decay(rec, *, channel=None, band=None, start: float | None = None,
     g_z = np.array([om ** 2, -sigma * om]) / wn ** 3
     zeta_std = float(np.sqrt((g_z[0] * sig_std) ** 2 + (g_z[1] * om_std) ** 2))
     fn_std = float(np.hypot(sigma * sig_std, om * om_std) / wn / (2 * np.pi))
-    if fsr * (t[ok][-1] - t[ok][0]) * fd0 / fsr < 5:
-        flags.append("few_cycles")
-    return _finish(rec, idx, "hilbert", wn / (2 * np.pi), zeta, fn_std, zeta_std, flags,
-                   {"band_hz": list(band), "fit_from_s": float(tt[0]), "fit_to_s": float(tt[-1]),
-                    "start_s": i0 / fsr + rec.t0})
+    return wn, zeta, fn_std, zeta_std
 
 
 @memory_guard
