@@ -1,0 +1,263 @@
+"""Output-only modal analysis by frequency-domain decomposition (FDD) and enhanced FDD (EFDD):
+the SVD of the outputs' cross-spectral matrix at every line, peaks by a stated rule, EFDD damping
+from the singular-value bell fitted as a free decay, stds from a jackknife over segment groups.
+The shared checks and shape measures are in :mod:`vibmeasure.identify.oma`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core._threads import single_threaded
+from ..core._validate import check_band
+from ..core.errors import FitError, ParameterError, warn_quality
+from ..core.record import Record
+from ..core.results import ModalEstimate
+from .oma import N_GROUPS, TONE_KURTOSIS, _check_duration, _mac, _normalise, _outputs, band_kurtosis, mpc
+
+__all__ = ["oma_fdd"]
+
+
+# --- FDD / EFDD ---------------------------------------------------------------------------------
+def _csd_matrix(Y, fs, nperseg):
+    """Output cross-spectral matrix G (n_freq, l, l), Hann-windowed segments with 50 % overlap, each
+    zero-padded to 2 nperseg so that the inverse transform of a bell is a linear (not circular)
+    correlation; one-sided PSD units."""
+    l, n = Y.shape
+    w = np.hanning(nperseg + 1)[:-1] if nperseg > 1 else np.ones(1)
+    step = nperseg // 2
+    starts = range(0, n - nperseg + 1, step)
+    nf = nperseg + 1
+    n_seg = len(starts)
+    n_g = N_GROUPS if n_seg >= 2 * N_GROUPS and nf * l * l * 16 * N_GROUPS < 5e8 else 0
+    Gg = np.zeros((max(n_g, 1), nf, l, l), complex)
+    for j, k0 in enumerate(starts):
+        X = np.fft.rfft(Y[:, k0:k0 + nperseg] * w, n=2 * nperseg, axis=1)  # (l, nf)
+        Gg[j * n_g // n_seg if n_g else 0] += np.einsum("if,jf->fij", X, X.conj())
+    scale = 2.0 / (fs * np.sum(w ** 2) * n_seg)
+    Gg *= scale
+    Gg[:, 0] /= 2
+    G = Gg.sum(axis=0)
+    return np.fft.rfftfreq(2 * nperseg, 1 / fs), G, w, n_seg, (Gg if n_g else None)
+
+
+def _fdd_nperseg(nperseg, n):
+    if nperseg is None:
+        nper = 2 ** int(np.log2(max(n // 8, 16)))
+        return int(min(nper, 2 ** 16))
+    if isinstance(nperseg, bool) or not isinstance(nperseg, (int, np.integer)) or not 16 <= nperseg <= n // 2:
+        raise ParameterError(f"nperseg={nperseg!r} must be an integer from 16 to half the record ({n // 2}): "
+                             "the decomposition averages at least 3 segments")
+    return int(nperseg)
+
+
+def _fdd_peaks(f, S, U, sel, min_prom_db, df_seg, n_modes, Y, fs):
+    """Candidate modes: peaks of the first (and second) singular value in the band that stand
+    ``min_prom_db`` above their surroundings (prominence), whose singular vector is coherent around
+    the peak (MAC >= 0.9 with the lines two either side) and whose band is a random response (band
+    kurtosis >= TONE_KURTOSIS; a harmonic or an electrical line gives 1.5)."""
+    from scipy.signal import find_peaks
+    idx = np.flatnonzero(sel)
+    picked, rejected = [], []
+    for j in range(min(2, S.shape[1])):
+        s_db = 10 * np.log10(np.maximum(S[idx, j], 1e-300))
+        pk, props = find_peaks(s_db, prominence=min_prom_db)
+        if not pk.size:
+            continue
+        for p, prom in zip(pk, props["prominences"]):
+            wdt = _half_power_width(s_db, p)
+            i = idx[p]
+            u = U[i, :, j]
+            near = [U[k, :, j] for k in (i - 2, i + 2) if 0 <= k < U.shape[0]]
+            coh = min(_mac(u, v) for v in near) if near else 1.0
+            cand = {"line": int(i), "sv": j, "f": float(f[i]), "prominence_db": float(prom),
+                    "width_bins": float(wdt * (f[1] - f[0]) / df_seg), "coherence_mac": coh}
+            kurt = band_kurtosis(Y, fs, f[i], max(0.5 * wdt * (f[1] - f[0]), 10 * fs / Y.shape[1]), u)
+            cand["kurtosis"] = kurt
+            if kurt < TONE_KURTOSIS:
+                rejected.append(dict(cand, reason=f"a harmonic, not a mode: kurtosis {kurt:.2f} in its band (a "
+                                                  "sinusoid gives 1.5, a mode's random response 3)"))
+            elif coh < 0.9:
+                rejected.append(dict(cand, reason="singular vector not coherent around the peak (MAC < 0.9)"))
+            elif j > 0 and any(abs(c["line"] - i) <= 2 or _mac(U[c["line"], :, c["sv"]], u) >= 0.8 for c in picked):
+                continue  # the second singular value's peak belongs to a mode already found
+            else:
+                picked.append(cand)
+    picked.sort(key=lambda c: -c["prominence_db"])
+    if n_modes is not None:
+        rejected += [dict(c, reason=f"beyond n_modes={n_modes}") for c in picked[n_modes:]]
+        picked = picked[:n_modes]
+    return sorted(picked, key=lambda c: c["f"]), rejected
+
+
+def _half_power_width(s_db, p):
+    """Width (lines, interpolated) of the peak at p where it stays within 3 dB of its top."""
+    lvl = s_db[p] - 3.0
+    lo = p
+    while lo > 0 and s_db[lo - 1] > lvl:
+        lo -= 1
+    hi = p
+    while hi < s_db.size - 1 and s_db[hi + 1] > lvl:
+        hi += 1
+    left = lo - (s_db[lo] - lvl) / (s_db[lo] - s_db[lo - 1]) if lo > 0 else lo
+    right = hi + (s_db[hi] - lvl) / (s_db[hi] - s_db[hi + 1]) if hi < s_db.size - 1 else hi
+    return float(right - left)
+
+
+def _bell(S, U, cand, mac_bell):
+    """The SDOF bell of one mode: at each line the singular value whose vector matches the peak's
+    (MAC >= mac_bell), contiguous from the peak; zero elsewhere."""
+    ref = U[cand["line"], :, cand["sv"]]
+    bell = np.zeros(S.shape[0])
+    lines = []
+    for step in (-1, 1):
+        i = cand["line"] if step == 1 else cand["line"] - 1
+        while 0 <= i < S.shape[0]:
+            macs = [_mac(U[i, :, k], ref) for k in range(S.shape[1])]
+            k = int(np.argmax(macs))
+            if macs[k] < mac_bell:
+                break
+            bell[i] = S[i, k]
+            lines.append(i)
+            i += step
+    return bell, sorted(lines)
+
+
+def _efdd(bell, w, fs, nperseg):
+    """Fit the bell's correlation function (a free decay) with the ring-down estimator."""
+    from .ringdown import ringdown
+    r = np.fft.irfft(bell)[:nperseg]
+    wac = np.correlate(w, w, mode="full")[nperseg - 1:]
+    wac = wac / wac[0]
+    r = r / np.maximum(wac, 1e-12)
+    r0 = r[0]
+    env = np.abs(_analytic(r[: nperseg // 2]))
+    low = np.flatnonzero(env[4:] < 0.1 * r0)
+    end = int(low[0]) + 4 if low.size else nperseg // 2
+    end = max(min(end, int(np.argmax(wac < 0.3)) or nperseg // 2), 64)
+    import warnings
+    from ..core.errors import QualityWarning
+    with warnings.catch_warnings():   # the ring-down's own findings stay in its flags, read by the caller
+        warnings.simplefilter("ignore", QualityWarning)
+        est = ringdown(Record.from_array(r[:end] / r0, fs=fs, name="correlation"), n_modes=1, start=0.0)
+    return est, end
+
+
+def _analytic(x):
+    from scipy.signal import hilbert
+    return hilbert(x)
+
+
+@single_threaded
+def oma_fdd(rec, *, band, nperseg: int | None = None, channels=None, n_modes: int | None = None,
+            min_prominence_db: float = 6.0, mac_bell: float = 0.8) -> ModalEstimate:
+    """Modes from output-only data by frequency-domain decomposition, damping by EFDD.
+
+    The cross-spectral matrix of the outputs (Hann, 50 % overlap, ``nperseg`` samples per segment)
+    is decomposed by SVD at every line. Peak rule: a peak of the first (or, for close modes, the
+    second) singular value in ``band`` is a mode when it stands ``min_prominence_db`` above its
+    surroundings, its singular vector is coherent around it (MAC >= 0.9 two lines either side) and
+    its band is a random response, not a harmonic (band kurtosis >= 2.2; a sinusoid gives 1.5);
+    ``n_modes`` keeps the most prominent. EFDD: the lines around each peak whose singular vector matches the peak's (MAC >=
+    ``mac_bell``) form the mode's SDOF bell; its inverse transform, corrected for the window, is the
+    mode's correlation function (a free decay), fitted by ``vm.ringdown`` for fn and zeta. Their
+    stds come from a jackknife over 8 groups of segments (each left out, the decomposition and EFDD
+    repeated; the ring-down fit's own std where larger), or the ring-down fit's std alone (a lower
+    bound: it takes the correlation function's errors as white) when the record has fewer than 16
+    segments. Shapes are the singular vectors at the peaks.
+    """
+    Y, names = _outputs(rec, channels, "oma_fdd", 1)
+    try:
+        min_prominence_db, mac_bell = float(min_prominence_db), float(mac_bell)
+    except (TypeError, ValueError):
+        raise ParameterError(f"min_prominence_db={min_prominence_db!r} and mac_bell={mac_bell!r} must be numbers") \
+            from None
+    if not (np.isfinite(min_prominence_db) and min_prominence_db > 0):
+        raise ParameterError(f"min_prominence_db={min_prominence_db!r} must be a positive number of dB")
+    if band is None:
+        raise ParameterError("oma_fdd: band=(lo, hi) in Hz is required: the range to search for modes")
+    band = check_band(band, rec.fs)
+    if band[0] > 0:
+        _check_duration(Y.shape[1], rec.fs, band[0], "oma_fdd")
+    nper = _fdd_nperseg(nperseg, Y.shape[1])
+    if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer))
+                                or n_modes < 1):
+        raise ParameterError(f"n_modes={n_modes!r} must be None or an integer >= 1")
+    if not 0 < mac_bell < 1:
+        raise ParameterError(f"mac_bell={mac_bell!r} must be between 0 and 1")
+    f, G, w, n_seg, Gg = _csd_matrix(Y, rec.fs, nper)
+    U, S, _ = np.linalg.svd(G)
+    sel = (f >= band[0]) & (f <= band[1])
+    picked, rejected = _fdd_peaks(f, S, U, sel, float(min_prominence_db), rec.fs / nper, n_modes, Y, rec.fs)
+    if not picked:
+        raise FitError(f"oma_fdd: no peak in band={band} stands {min_prominence_db} dB out of the singular values "
+                       f"as a resonance (rejected: {[(round(c['f'], 3), c['reason']) for c in rejected]})")
+    return _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg, Gg)
+
+
+def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper):
+    """Leave-one-group-out EFDD of one mode (the segments in N_GROUPS groups): jackknife std of fn
+    and zeta, or None when fewer than all but one replicate succeed."""
+    lo, hi = max(lines[0] - 5, 0), min(lines[-1] + 6, Gg.shape[1])
+    tot = Gg[:, lo:hi].sum(axis=0)
+    ref = U[c["line"], :, c["sv"]]
+    vals = []
+    for g in range(Gg.shape[0]):
+        Ur, Sr, _ = np.linalg.svd(tot - Gg[g, lo:hi])
+        k = int(np.argmax([_mac(Ur[c["line"] - lo, :, j], ref) for j in range(Sr.shape[1])]))
+        sub, sub_lines = _bell(Sr, Ur, dict(c, line=c["line"] - lo, sv=k), mac_bell)
+        bell = np.zeros(Gg.shape[1])
+        bell[lo:hi] = sub
+        try:
+            e, _ = _efdd(bell, w, fs, nper)
+            vals.append((e.fn[0], e.zeta[0]))
+        except (FitError, ParameterError):
+            continue
+    n = Gg.shape[0]
+    if len(vals) < n - 1:
+        return None
+    v = np.array(vals)
+    return np.sqrt((n - 1) / len(v) * np.sum((v - v.mean(axis=0)) ** 2, axis=0))
+
+
+def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg, Gg):
+    fn, zeta, fn_std, zeta_std, flags, bells = [], [], [], [], [], []
+    for c in picked:
+        bell, lines = _bell(S, U, c, mac_bell)
+        fl = []
+        try:
+            e, end = _efdd(bell, w, rec.fs, nper)
+            jk = _efdd_jackknife(Gg, c, lines, U, mac_bell, w, rec.fs, nper) if Gg is not None else None
+            stds = (e.fn_std[0], e.zeta_std[0]) if jk is None else (max(jk[0], e.fn_std[0]), max(jk[1], e.zeta_std[0]))
+            vals = (e.fn[0], e.zeta[0], *stds)
+            fl += [x for x in e.flags if x in ("few_cycles", "low_snr")]
+        except (FitError, ParameterError) as err:
+            vals, end = (c["f"], np.nan, np.nan, np.nan), 0
+            fl.append("efdd_failed")
+            c["efdd_error"] = str(err)
+        if len(lines) < 5:
+            fl.append("resolution_limited")
+        for lst, v in zip((fn, zeta, fn_std, zeta_std), vals):
+            lst.append(float(v))
+        flags.append(tuple(fl))
+        bells.append({"f_lo": float(f[lines[0]]), "f_hi": float(f[lines[-1]]), "n_lines": len(lines),
+                      "decay_samples": int(end), "singular_value": c["sv"] + 1})
+    phi = _normalise(np.column_stack([U[c["line"], :, c["sv"]] for c in picked]))
+    show = (f >= max(0.0, band[0] - 0.1 * (band[1] - band[0]))) & (f <= band[1] + 0.1 * (band[1] - band[0]))
+    extras = {"peaks": picked, "rejected_peaks": rejected, "bells": bells, "band_hz": list(band), "nperseg": nper,
+              "n_segments": n_seg, "outputs": names, "mpc": mpc(phi).tolist(), "mac": np.abs(_mac_matrix(phi)).tolist(),
+              "singular_values": {"freq": f[show], "values": S[show].T, "unit": f"({rec.channels[0].unit})^2/Hz"},
+              "rule": "peaks of the singular values standing min_prominence_db out, coherent singular vector "
+                      "(MAC >= 0.9 over +-2 lines), band kurtosis >= 2.2 (not a harmonic)",
+              "std_method": f"jackknife over {N_GROUPS} groups of segments (each left out, EFDD repeated); the "
+                            "ring-down fit's own std where larger" if Gg is not None else
+                            "ring-down fit of the EFDD correlation function (white-error assumption: a lower bound)"}
+    est = ModalEstimate(fn=fn, zeta=zeta, fn_std=fn_std, zeta_std=zeta_std, method="oma_fdd", mode_flags=tuple(flags),
+                        shapes=phi, unit=rec.channels[0].unit, extras=extras)
+    if "efdd_failed" in est.flags:
+        warn_quality("oma_fdd: EFDD could not fit the decay of some mode(s): their damping is NaN (see "
+                     "extras['peaks'][k]['efdd_error'])", stacklevel=3)
+    return est
+
+
+def _mac_matrix(phi):
+    return np.array([[_mac(a, b) for b in phi.T] for a in phi.T])
