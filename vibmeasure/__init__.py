@@ -28,7 +28,7 @@ _LAZY = {
     "impact_frf": (".identify.frf", "impact_frf"),
     "circle_fit": (".identify.modal", "circle_fit"),
     "oma_ssi": (".identify.oma", "oma_ssi"),
-    "oma_fdd": (".identify.oma", "oma_fdd"),
+    "oma_fdd": (".identify.oma_fdd", "oma_fdd"),
     "fit_modes": (".identify.modal", "fit_modes"),
     "mac": (".identify.modal", "mac"),
     "modal_crb": (".identify.modal", "modal_crb"),

@@ -1,5 +1,5 @@
 """Ring-down special cases: dry (Coulomb) friction, damping that changes with amplitude, and the
-over-damped decay (steps of :func:`vibmeasure.ringdown`)."""
+over-damped decay, and each reported mode's backbone (steps of :func:`vibmeasure.ringdown`)."""
 
 from __future__ import annotations
 
@@ -248,3 +248,21 @@ def _overdamped_try(x, fs, rec, idx, flags):
                  f"({ra:.4g}, {rb:.4g} 1/s), no natural frequency is reported", stacklevel=5)
     return est
 
+
+def _add_backbone(extras, flags, iso, fs, fn, zeta, noise, j):
+    """fn and zeta versus amplitude of reported mode j (isolated from the others; a table with a
+    ``mode`` column), its weakly nonlinear model in extras["backbone_model"][j], and the flag
+    amplitude_dependent_frequency when fn moves significantly (slope on log amplitude above 4 std)
+    by more than 1e-4 over the amplitude range."""
+    from .backbone import backbone, fit_backbone, frequency_trend
+    bb = backbone(iso, fs, fn=fn, zeta=zeta, noise=noise)
+    if bb.empty:
+        return None
+    bb.insert(0, "mode", j)
+    if len(bb) >= 4:
+        extras.setdefault("backbone_model", {})[j] = fit_backbone(bb)
+        change, signif = frequency_trend(bb)
+        if signif > 4 and abs(change) > 1e-4:
+            flags.append("amplitude_dependent_frequency")
+            extras.setdefault("frequency_change_over_decay", {})[j] = change
+    return bb

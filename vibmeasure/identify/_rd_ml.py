@@ -1,10 +1,13 @@
 """Ring-down maximum likelihood: the damped-sinusoid model with offset and drift, its Jacobian in
 bounded chunks, Levenberg-Marquardt, and each component's share and energy (steps of
-:func:`vibmeasure.ringdown`)."""
+:func:`vibmeasure.ringdown`), and the Cramer-Rao bound of that model (:func:`ringdown_crb`)."""
 
 from __future__ import annotations
 
 import numpy as np
+
+from ..core.errors import ParameterError
+from ._poles import pole_to_modal
 
 CHUNK = 1 << 16
 
@@ -201,3 +204,33 @@ def _colored_noise_scale(resid, w, fs, fd, bw, noise):
             scale[k] = np.sqrt(ratio)
     return scale
 
+
+def ringdown_crb(*, fn: float, zeta: float, fs: float, duration: float, amplitude: float = 1.0,
+                 phase: float = 0.0, noise_std: float | None = None, snr_db: float | None = None) -> dict:
+    """Cramer-Rao bound on fn and zeta for one damped sinusoid in white Gaussian noise.
+
+    The signal is ``amplitude * exp(-zeta wn t) cos(wd t + phase)`` sampled at ``fs`` for
+    ``duration`` s; the noise std is given, or follows from ``snr_db`` = 10 log10(A^2 / (2 s^2)).
+    The bound is the inverse Fisher information of (sigma, wd, a, b), mapped to fn and zeta.
+    Use it to plan a test: the std any unbiased estimator can reach.
+    Returns dict with fn_std, zeta_std (and fn, zeta).
+    """
+    from ..core._validate import positive
+    fn, fs, duration = positive(fn, "fn"), positive(fs, "fs"), positive(duration, "duration")
+    if not 0 < zeta < 1:
+        raise ParameterError(f"zeta={zeta} must be in (0, 1) for an oscillating decay")
+    if (noise_std is None) == (snr_db is None):
+        raise ParameterError("give exactly one of noise_std and snr_db")
+    s = noise_std if noise_std is not None else abs(amplitude) / np.sqrt(2 * 10 ** (snr_db / 10))
+    s = positive(s, "noise_std")
+    wn = 2 * np.pi * fn
+    sig, om = zeta * wn, wn * np.sqrt(1 - zeta ** 2)
+    t = np.arange(int(round(duration * fs))) / fs
+    a, b = amplitude * np.cos(phase), -amplitude * np.sin(phase)
+    e = np.exp(-sig * t)
+    c, sn = e * np.cos(om * t), e * np.sin(om * t)
+    m = a * c + b * sn
+    J = np.column_stack([-t * m, t * (b * c - a * sn), c, sn])
+    cov = s ** 2 * np.linalg.inv(J.T @ J)
+    _, _, fn_std, zeta_std = pole_to_modal(sig, om, cov[:2, :2])
+    return {"fn": fn, "zeta": zeta, "fn_std": fn_std, "zeta_std": zeta_std, "noise_std": float(s)}

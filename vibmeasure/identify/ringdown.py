@@ -27,9 +27,10 @@ from ..core.record import Record
 from ..core.results import FLAG_TEXT, ModalEstimate
 from ._decay import band_noise_std, clipped_mask, decay_start, decimation_factor, trim_to_decay
 from ._poles import pole_to_modal
-from ._rd_checks import _amplitude_check, _coulomb_check, _dominant_cycles, _nonlinear_damping, _overdamped_try
-from ._rd_ml import (_colored_noise_scale, _evaluate, _lm, _mode_energy, _mode_model, _mode_shares,
-                     _pack)
+from ._rd_checks import (_add_backbone, _amplitude_check, _coulomb_check, _dominant_cycles, _nonlinear_damping,
+                         _overdamped_try)
+from ._rd_ml import (_colored_noise_scale, _evaluate, _lm, _mode_energy, _mode_model, _mode_shares,  # noqa: F401
+                     _pack, ringdown_crb)  # ringdown_crb: public here too
 from ._rd_start import SUBSAMPLE, _esprit, _linear_amplitudes, _spectral_candidates
 
 __all__ = ["ringdown", "ringdown_crb"]
@@ -520,25 +521,6 @@ def _nonlinear_checks(d: _Decay, f: _Fit, c: _Modes, ik, extras, fn_r, zeta_r, z
         extras["zeta_vs_amplitude"] = nl["zeta_vs_amplitude"]
 
 
-def _add_backbone(extras, flags, iso, fs, fn, zeta, noise, j):
-    """fn and zeta versus amplitude of reported mode j (isolated from the others; a table with a
-    ``mode`` column), its weakly nonlinear model in extras["backbone_model"][j], and the flag
-    amplitude_dependent_frequency when fn moves significantly (slope on log amplitude above 4 std)
-    by more than 1e-4 over the amplitude range."""
-    from .backbone import backbone, fit_backbone, frequency_trend
-    bb = backbone(iso, fs, fn=fn, zeta=zeta, noise=noise)
-    if bb.empty:
-        return None
-    bb.insert(0, "mode", j)
-    if len(bb) >= 4:
-        extras.setdefault("backbone_model", {})[j] = fit_backbone(bb)
-        change, signif = frequency_trend(bb)
-        if signif > 4 and abs(change) > 1e-4:
-            flags.append("amplitude_dependent_frequency")
-            extras.setdefault("frequency_change_over_decay", {})[j] = change
-    return bb
-
-
 def _warn_flags(est: ModalEstimate, rejected):
     serious = [f for f in est.flags if f not in ("noise_floor", "start_detected")]
     msgs = [f"{f}: {FLAG_TEXT.get(f, f)}" for f in serious]
@@ -546,34 +528,3 @@ def _warn_flags(est: ModalEstimate, rejected):
         msgs.append(f"{len(rejected)} mode(s) left out: damping relative std above {MAX_REL_ZETA_STD}")
     if msgs:
         warn_quality("ringdown: " + "; ".join(msgs), stacklevel=4)
-
-
-def ringdown_crb(*, fn: float, zeta: float, fs: float, duration: float, amplitude: float = 1.0,
-                 phase: float = 0.0, noise_std: float | None = None, snr_db: float | None = None) -> dict:
-    """Cramer-Rao bound on fn and zeta for one damped sinusoid in white Gaussian noise.
-
-    The signal is ``amplitude * exp(-zeta wn t) cos(wd t + phase)`` sampled at ``fs`` for
-    ``duration`` s; the noise std is given, or follows from ``snr_db`` = 10 log10(A^2 / (2 s^2)).
-    The bound is the inverse Fisher information of (sigma, wd, a, b), mapped to fn and zeta.
-    Use it to plan a test: the std any unbiased estimator can reach.
-    Returns dict with fn_std, zeta_std (and fn, zeta).
-    """
-    from ..core._validate import positive
-    fn, fs, duration = positive(fn, "fn"), positive(fs, "fs"), positive(duration, "duration")
-    if not 0 < zeta < 1:
-        raise ParameterError(f"zeta={zeta} must be in (0, 1) for an oscillating decay")
-    if (noise_std is None) == (snr_db is None):
-        raise ParameterError("give exactly one of noise_std and snr_db")
-    s = noise_std if noise_std is not None else abs(amplitude) / np.sqrt(2 * 10 ** (snr_db / 10))
-    s = positive(s, "noise_std")
-    wn = 2 * np.pi * fn
-    sig, om = zeta * wn, wn * np.sqrt(1 - zeta ** 2)
-    t = np.arange(int(round(duration * fs))) / fs
-    a, b = amplitude * np.cos(phase), -amplitude * np.sin(phase)
-    e = np.exp(-sig * t)
-    c, sn = e * np.cos(om * t), e * np.sin(om * t)
-    m = a * c + b * sn
-    J = np.column_stack([-t * m, t * (b * c - a * sn), c, sn])
-    cov = s ** 2 * np.linalg.inv(J.T @ J)
-    _, _, fn_std, zeta_std = pole_to_modal(sig, om, cov[:2, :2])
-    return {"fn": fn, "zeta": zeta, "fn_std": fn_std, "zeta_std": zeta_std, "noise_std": float(s)}
