@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import vibmeasure as vm
@@ -73,3 +74,39 @@ def test_bad_input_is_a_parameter_error_naming_the_argument(name):
     call, match = _bad_input_cases()[name]
     with pytest.raises(vm.ParameterError, match=match):
         call()
+
+
+def test_new_public_functions_of_session_4_name_their_bad_arguments():
+    # each refusal names the argument and its rule: no numpy/matplotlib error from deep inside
+    import matplotlib
+    matplotlib.use("Agg")
+    from vibmeasure import plot as P
+    from vibmeasure.signal.preprocess import extend
+    H = dict(fn=[20.0], zeta=[0.01], shapes=[[1.0]], fs=1024.0)
+    for kw, word in ((dict(peak_force=float("nan")), "peak_force"), (dict(peak_force="a"), "peak_force"),
+                     (dict(noise=-1.0), "noise"), (dict(duration=0.1), "duration"), (dict(double_at="x"), "double_at"),
+                     (dict(double_at=9.0), "double_at"), (dict(hits=[]), "hits"), (dict(quantity="jerk"), "quantity")):
+        with pytest.raises(vm.ParameterError, match=word):
+            vm.synth.hammer_test(**H, **kw)
+    with pytest.raises(vm.ParameterError, match="finite"):
+        extend(np.array([1.0, np.nan, 2.0, 3.0, 4.0]), 10)
+    with pytest.raises(vm.ParameterError, match="n_ext"):
+        extend(np.arange(10.0), 2.5)
+    freq = np.arange(0, 50.0625, 0.0625)
+    est = vm.fit_modes(vm.synth.modal_frf(freq, fn=[10.0, 30.0], zeta=[0.02, 0.02], shapes=[[1.0, 0.7]]), band=(2, 45))
+    with pytest.raises(vm.ParameterError, match="freq must be a 1-D array of finite"):
+        vm.synthesize_frf(est, [np.nan], residuals=True)
+    with pytest.raises(vm.ParameterError, match="freq must be > 0"):
+        vm.synthesize_frf(est, freq, residuals=True)
+    spec = vm.psd(vm.synth.free_decay(fn=12.0, zeta=0.02, fs=500.0, duration=6.0, snr_db=40, seed=2))
+    with pytest.raises(vm.ParameterError, match="fmax"):
+        P.plot_spectrum(spec, fmax="x")
+    with pytest.raises(vm.ParameterError, match="db="):
+        P.plot_spectrum(spec, db="yes")
+    rec = vm.synth.free_decay(fn=12.0, zeta=0.02, fs=500.0, duration=6.0, snr_db=40, seed=2)
+    cmp = vm.compare(vm.ringdown(rec), vm.models.SDOF(m=1.0, k=(2 * np.pi * 12.0) ** 2, zeta=0.02))
+    for bad in ("x", -1.0):
+        with pytest.raises(vm.ParameterError, match="rtol_zeta"):
+            P.plot_comparison(cmp, rtol_zeta=bad)
+    import matplotlib.pyplot as plt
+    plt.close("all")

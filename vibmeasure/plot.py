@@ -130,8 +130,14 @@ def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: b
     from .core.results import Spectrum
     if not isinstance(spec, Spectrum):
         raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
-    if fmax is not None and not (np.isfinite(fmax) and fmax > 0):
-        raise ParameterError(f"fmax={fmax!r} must be a positive frequency in Hz")
+    if fmax is not None:
+        from .core._validate import positive
+        try:
+            fmax = positive(fmax, "fmax")
+        except ParameterError:
+            raise ParameterError(f"fmax={fmax!r} must be a positive frequency in Hz") from None
+    if not isinstance(db, (bool, np.bool_)):
+        raise ParameterError(f"db={db!r} must be True or False")
     if ax is None:
         _, ax = plt.subplots(figsize=(9, 4.5))
     rows = range(spec.n_channels) if channel is None else [name_index(spec.channels, channel)]
@@ -547,6 +553,8 @@ def plot_comparison(cmp, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.5, again
     tolerance +-rtol_fn and, where known, one-std error bars; on a figure of its own also the zeta
     deviation (%) beside it, with its tolerance +-rtol_zeta. Returns the fn axes."""
     import matplotlib.pyplot as plt
+    from .core._validate import positive
+    rtol_fn, rtol_zeta = positive(rtol_fn, "rtol_fn"), positive(rtol_zeta, "rtol_zeta")
     ax_z = None
     if ax is None:
         _, (ax, ax_z) = plt.subplots(1, 2, figsize=(10, 4), width_ratios=(3, 2))

@@ -219,7 +219,15 @@ def hammer_test(*, fn, zeta, shapes, fs: float, hits=(0.2, 2.2, 4.2), duration: 
     width = positive(width, "width")
     if width * fs < 3:
         raise ParameterError(f"width={width} s is shorter than 3 samples at fs={fs} Hz: the pulse cannot be sampled")
+    peak_force = positive(peak_force, "peak_force")
+    noise, force_noise = positive(noise, "noise", allow_zero=True), positive(force_noise, "force_noise", allow_zero=True)
     T = float(hits.max() + 2.0) if duration is None else positive(duration, "duration")
+    if hits.max() + width > T:
+        raise ParameterError(f"duration={T:g} s ends before the last hit (at {hits.max():g} s) is over")
+    if double_at is not None:
+        double_at = positive(double_at, "double_at", allow_zero=True)
+        if double_at + width > T:
+            raise ParameterError(f"double_at={double_at:g} s is after the record's end ({T:g} s)")
     n = int(round(T * fs))
     t = np.arange(n) / fs
     f = np.zeros(n)

@@ -33,9 +33,9 @@ def _window_fit(y, t, sig, om):
     """ML fit of a*e^{-s t}cos(w t) + b*e^{-s t}sin(w t) + c on one window: (p, cov, rss) or None.
 
     Gauss-Newton on (s, w) with the linear part (a, b, c) solved exactly at each step (variable
-    projection); small normal equations throughout, a handful of iterations from the start given
-    (the previous window's solution, else the global estimate). The Jacobian rows (d/ds, d/dw, cos,
-    sin, 1) live in one array, so one product gives both the linear and the full normal equations."""
+    projection); small normal equations throughout, a handful of iterations from the global start.
+    The Jacobian rows (d/ds, d/dw, cos, sin, 1) live in one array, so one product gives both the
+    linear and the full normal equations. (The window-by-window fallback of _windows_fit.)"""
     p = np.array([sig, om, 0.0, 0.0, 0.0])
     J = np.empty((5, t.size))
     J[4] = 1.0

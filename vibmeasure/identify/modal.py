@@ -288,7 +288,12 @@ def synthesize_frf(est: ModalEstimate, freq, *, residuals: bool = False) -> np.n
     poly-reference fit, in ``extras["rows"]`` order)."""
     if "poles" not in est.extras or "residues" not in est.extras:
         raise ParameterError("est must come from vm.fit_modes (it needs poles and residues)")
-    w = 2 * np.pi * np.asarray(freq, float)
+    try:
+        w = 2 * np.pi * np.asarray(freq, float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"freq must be frequencies in Hz, got {type(freq).__name__}") from None
+    if w.ndim > 1 or not np.isfinite(w).all():
+        raise ParameterError("freq must be a 1-D array of finite frequencies in Hz")
     if residuals and np.any(w <= 0):
         raise ParameterError("freq must be > 0 where the residual terms are synthesised (the lower term is 1/(iw)^2)")
     iw = 1j * w

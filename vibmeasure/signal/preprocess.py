@@ -155,7 +155,11 @@ def extend(x: np.ndarray, n_ext: int, *, order: int = EXTEND_ORDER) -> np.ndarra
     Transforms and filters of the extended signal have their wrap-around and start-up at its far
     ends, not in the record."""
     x = np.asarray(x, float)
-    if n_ext <= 0 or x.size < 4:
+    if isinstance(n_ext, bool) or not isinstance(n_ext, (int, np.integer)) or n_ext < 0:
+        raise ParameterError(f"n_ext={n_ext!r} must be an integer >= 0 (samples added at each end)")
+    if x.ndim != 1 or not np.isfinite(x).all():
+        raise ParameterError("x must be a 1-D array of finite samples: the prediction would carry a NaN/inf forward")
+    if n_ext == 0 or x.size < 4:
         return x.copy()
     a = burg(x, order)
 
