@@ -51,11 +51,22 @@ class Clock:
     def __init__(self):
         self.times = []
         self.first = None
+        self.rss = []   # (results taken, client RSS in kB) every 25 results
 
     def __call__(self, done, total):
         now = time.perf_counter()
         self.first = self.first or now
         self.times.append(now)
+        if done % 25 == 0:
+            self.rss.append((done, rss_mb() * 1024))
+
+    def growth(self):
+        """The client's RSS slope (kB per record) over the second half of the run: what it keeps per
+        record once the allocator's pools and the first imports are in place."""
+        pts = np.array(self.rss[len(self.rss) // 2:], float)
+        if len(pts) < 3:
+            return float("nan"), float("nan")
+        return float(np.polyfit(pts[:, 0], pts[:, 1], 1)[0]), float(pts[-1, 1] - pts[0, 1])
 
     def rate(self):
         t = self.times[9:] if len(self.times) > 20 else self.times
@@ -131,6 +142,10 @@ def main():
         print(f"  2 workers / serial: {t_serial / t_dask:.2f}x overall (target >= 1.7x on 2 cores); "
               f"{clock_d.rate() / clock_s.rate():.2f}x once running ({clock_s.rate():.1f} and {clock_d.rate():.1f} "
               "records/s from the 10th to the last result)")
+        for name, c in (("serial", clock_s), ("2 workers", clock_d)):
+            slope, rise = c.growth()
+            print(f"  client memory, {name}: {slope:+.2f} kB per record over the second half of the run "
+                  f"({rise / 1024:+.1f} MB in all; target: bounded, ~0 kB per record)")
         ceiling = parallel_ceiling(vm.read_manifest(man)[0])
         print(f"  this machine's ceiling: two processes doing the same work at once run {ceiling:.2f}x one "
               "process (2.0 on independent cores)")

@@ -52,6 +52,41 @@ def test_store_round_trip_is_exact(tmp_path):
     assert len(st.results("spectrum", since="2026-01-02", until="2026-01-02T23:00")) == 1
 
 
+def test_store_finds_hashes_on_disk_and_keeps_no_rows_in_memory(tmp_path):
+    import tracemalloc
+    p = tmp_path / "s.h5"
+    sha = lambda i: f"{i:064x}"  # noqa: E731
+    twin = "0" * 16 + "f" * 48  # the same first 64 bits as sha(0): the index must confirm on disk
+    tracemalloc.start()
+    try:
+        with vm.Store(p, writable=True) as st:
+            st.add_asset("a")
+            st.add_point("a", "p")
+            for i in range(300):
+                mid = st.add_measurement("a", "p", time=1e9 + i, sha256=sha(i))
+                st.add_result(mid, "spectrum", {"payload": list(range(200))}, summary={"rms": float(i)})
+                if i % 50 == 49:
+                    st.commit()
+                if i == 99:
+                    before = tracemalloc.get_traced_memory()[0]
+            grown = tracemalloc.get_traced_memory()[0] - before
+            assert st.has(sha(7)) == "m0000008" and st.has(twin) is None and st.has(sha(300)) is None
+            mid = st.add_measurement("a", "p", time=2e9, sha256=sha(7))  # pending: the latest wins
+            assert st.has(sha(7)) == mid == "m0000301"
+    finally:
+        tracemalloc.stop()
+    # after 200 more committed measurements with results, what stays is the hash index (16 bytes each)
+    # and assets/points; holding the rows (about 2 kB each with summaries) would grow by ~400 kB
+    assert grown < 200 * 100, grown
+    st = vm.Store(p)
+    assert st.has(sha(7)) == "m0000301" and st.has(sha(299)) == "m0000300" and st.n_measurements == 301
+    with vm.Store(p, writable=True) as w:  # a reader's view is the file it opened: later commits only append
+        w.add_result(w.add_measurement("a", "p", time=3e9), "spectrum", {}, summary={"rms": -1.0})
+    assert len(st.results("spectrum")) == 300 and len(vm.Store(p).results("spectrum")) == 301
+    with pytest.raises(vm.ParameterError, match="is not in store"):
+        st.record("m0000999")
+
+
 def test_store_refuses_another_schema_version(tmp_path, monkeypatch):
     p = tmp_path / "s.h5"
     monkeypatch.setattr(store_mod, "STORE_VERSION", 2)

@@ -35,6 +35,14 @@ TABLES = ("assets", "points", "measurements", "results")
 TASK_ALIASES = {"diagnosis": "diagnose", "modal": "modes", "spectra": "spectrum", "comparison": "compare"}
 
 
+def _hash_key(sha256: str) -> int:
+    """The first 64 bits of a hex SHA-256: the in-memory index key (8 bytes per measurement)."""
+    try:
+        return np.uint64(int(sha256[:16], 16))
+    except ValueError:
+        return np.uint64(0)
+
+
 class StoreLockedError(VibMeasureError):
     """Another process holds the store's writer lock."""
 
@@ -67,18 +75,27 @@ class Store:
         self.path = Path(path)
         self.writable = bool(writable)
         self._lock_fd = None
+        # in memory: assets and points (the fleet's size), the committed row counts, a compact index of
+        # the measurements' content hashes and the rows not yet committed; every measurement and result
+        # row stays on disk until a query reads it, so a long batch's client does not grow
         self._pending: dict[str, list] = {k: [] for k in TABLES}
         self._raw_pending: dict[str, object] = {}
+        self._n = {k: 0 for k in TABLES}
+        self._assets: dict[str, dict] = {}
+        self._points: dict[tuple, dict] = {}
+        self._pending_meas: dict[str, dict] = {}
+        self._hash_keys = np.empty(0, np.uint64)   # first 64 bits of each stored SHA-256, sorted
+        self._hash_rows = np.empty(0, np.int64)    # the measurement row of each key
         if self.writable:
             self._lock(timeout)
         try:
-            self._rows = self._load() if self.path.exists() else {k: [] for k in TABLES}
+            if self.path.exists():
+                self._load()
         except BaseException:
             self._unlock()
             raise
         if not self.path.exists() and not self.writable:
             raise ParameterError(f"store {str(self.path)!r} does not exist (open it with writable=True to create it)")
-        self._index()
 
     # --- locking -------------------------------------------------------------------------------
     def _lock(self, timeout):
@@ -138,8 +155,14 @@ class Store:
             pass
 
     # --- reading ------------------------------------------------------------------------------
-    def _load(self) -> dict:
+    def _open(self):
         import h5py
+        try:
+            return h5py.File(self.path, "r")
+        except OSError as exc:
+            raise ParameterError(f"store {str(self.path)!r} is damaged: {exc}") from None
+
+    def _load(self) -> None:
         from .hdf5 import check_seal
         src = f"store {str(self.path)!r}"
         if not self.path.is_file():
@@ -147,7 +170,7 @@ class Store:
         if not check_seal(self.path, src):
             raise ParameterError(f"{src} is not a vibmeasure store (no seal: not written by vm.Store)")
         try:
-            with h5py.File(self.path, "r") as f:
+            with self._open() as f:
                 schema = f.attrs.get("vibmeasure_schema")
                 schema = schema.decode() if isinstance(schema, bytes) else schema
                 if schema != STORE_SCHEMA:
@@ -156,28 +179,49 @@ class Store:
                 if version != STORE_VERSION:
                     raise ParameterError(f"{src} has store schema version {version}; this vibmeasure reads version "
                                          f"{STORE_VERSION} (upgrade vibmeasure, or convert the store)")
-                rows = {}
-                for k in TABLES:
-                    d = f[k]
-                    rows[k] = [json.loads(v) for v in d.asstr()[()]] if d.shape[0] else []
-                for i, r in enumerate(rows["results"]):  # full results stay on disk until asked for
-                    r["result"], r["_row"] = None, i
+                self._n = {k: int(f[k].shape[0]) for k in TABLES}
+                self._assets = {r["asset"]: r for r in self._rows_of(f, "assets")}
+                self._points = {(r["asset"], r["point"]): r for r in self._rows_of(f, "points")}
+                keys, rows = [], []
+                for i, r in enumerate(self._rows_of(f, "measurements")):
+                    if r.get("sha256"):
+                        keys.append(_hash_key(r["sha256"]))
+                        rows.append(i)
         except (OSError, KeyError, ValueError, TypeError) as exc:
             if isinstance(exc, ParameterError):
                 raise
             raise ParameterError(f"{src} is damaged: {exc}") from None
-        return rows
+        keys = np.array(keys, np.uint64)
+        order = np.argsort(keys, kind="stable")
+        self._hash_keys, self._hash_rows = keys[order], np.array(rows, np.int64)[order]
 
-    def _index(self):
-        allrows = {k: self._rows[k] + self._pending[k] for k in TABLES}
-        self._assets = {r["asset"]: r for r in allrows["assets"]}
-        self._points = {(r["asset"], r["point"]): r for r in allrows["points"]}
-        self._meas = {r["id"]: r for r in allrows["measurements"]}
-        self._hashes = {r["sha256"]: r["id"] for r in allrows["measurements"] if r.get("sha256")}
+    def _rows_of(self, f, table, chunk: int = 4096):
+        """The committed rows of a table as dicts, read in chunks (only the rows this Store has seen
+        committed: a later commit by another writer only appends)."""
+        d = f[table].asstr()
+        n = min(self._n[table], d.shape[0])
+        for i0 in range(0, n, chunk):
+            for v in d[i0:min(i0 + chunk, n)]:
+                yield json.loads(v)
+
+    def _each(self, table):
+        """Every row of a table, committed (streamed from the file) then pending."""
+        if self._n[table]:
+            try:
+                with self._open() as f:
+                    yield from self._rows_of(f, table)
+            except (KeyError, ValueError, TypeError) as exc:
+                raise ParameterError(f"store {str(self.path)!r} is damaged: {exc}") from None
+        yield from self._pending[table]
 
     def _frame(self, table, **filters):
         import pandas as pd
-        rows = self._rows[table] + self._pending[table]
+        if table == "assets":
+            rows = list(self._assets.values())
+        elif table == "points":
+            rows = list(self._points.values())
+        else:
+            rows = list(self._each(table))
         df = pd.DataFrame(rows)
         for k, v in filters.items():
             if v is not None and k in df:
@@ -201,25 +245,17 @@ class Store:
         version, params, the summary values as columns and ``result`` (the full result, a dict)."""
         import pandas as pd
         task = TASK_ALIASES.get(task, task)
-        rows = [r for r in self._rows["results"] + self._pending["results"] if r["task"] == task]
+        meas = {r["id"]: (r["asset"], r["point"], r["time"]) for r in self._each("measurements")}
         flat = []
-        for r in rows:
-            m = self._meas.get(r["measurement"], {})
-            if asset is not None and m.get("asset") != asset or point is not None and m.get("point") != point:
+        for r in self._each("results"):
+            if r["task"] != task:
                 continue
-            flat.append({"measurement": r["measurement"], "asset": m.get("asset"), "point": m.get("point"),
-                         "time": m.get("time"), "task": r["task"], "version": r["version"],
-                         "params": r.get("params", {}), **r.get("summary", {}), "result": r.get("result"),
-                         "_row": r.get("_row")})
-        lazy = [i for i, r in enumerate(flat) if r["_row"] is not None and r["result"] is None]
-        if lazy:
-            import h5py
-            with h5py.File(self.path, "r") as f:
-                d = f["results"].asstr()
-                for i in lazy:
-                    flat[i]["result"] = json.loads(d[flat[i]["_row"]])["result"]
-        for r in flat:
-            r.pop("_row")
+            a, p, t = meas.get(r["measurement"], (None, None, None))
+            if asset is not None and a != asset or point is not None and p != point:
+                continue
+            flat.append({"measurement": r["measurement"], "asset": a, "point": p, "time": t, "task": r["task"],
+                         "version": r["version"], "params": r.get("params", {}), **r.get("summary", {}),
+                         "result": r.get("result")})
         df = pd.DataFrame(flat)
         if df.empty:
             return pd.DataFrame(columns=["measurement", "asset", "point", "time", "task", "version", "params"])
@@ -246,8 +282,37 @@ class Store:
         return df
 
     def has(self, sha256: str) -> str | None:
-        """The measurement id already stored for this content hash, or None."""
-        return self._hashes.get(sha256)
+        """The measurement id already stored for this content hash, or None (the latest if several)."""
+        for mid in reversed(self._pending_meas):
+            if self._pending_meas[mid].get("sha256") == sha256:
+                return mid
+        if not isinstance(sha256, str) or not sha256:
+            return None
+        key = _hash_key(sha256)
+        i = int(np.searchsorted(self._hash_keys, key, side="right"))
+        if not i or self._hash_keys[i - 1] != key:
+            return None
+        with self._open() as f:  # the index holds 64 bits of the hash: confirm on the stored row
+            d = f["measurements"].asstr()
+            while i and self._hash_keys[i - 1] == key:
+                i -= 1
+                row = json.loads(d[int(self._hash_rows[i])])
+                if row.get("sha256") == sha256:
+                    return row["id"]
+        return None
+
+    def _known(self, measurement) -> bool:
+        if measurement in self._pending_meas:
+            return True
+        if not isinstance(measurement, str) or len(measurement) < 8 or measurement[0] != "m" \
+                or not measurement[1:].isdigit():
+            return False
+        return 1 <= int(measurement[1:]) <= self._n["measurements"]
+
+    @property
+    def n_measurements(self) -> int:
+        """Measurements in the store, committed or pending."""
+        return self._n["measurements"] + len(self._pending["measurements"])
 
     def record(self, measurement: str):
         """The raw record stored with a measurement (``keep_raw=True``)."""
@@ -255,9 +320,9 @@ class Store:
         from ..core.record import Channel, Record
         if measurement in self._raw_pending:
             return self._raw_pending[measurement]
-        if measurement not in self._meas:
+        if not self._known(measurement):
             raise ParameterError(f"measurement={measurement!r} is not in store {str(self.path)!r}")
-        with h5py.File(self.path, "r") as f:
+        with self._open() as f:
             if f"raw/{measurement}" not in f:
                 raise ParameterError(f"measurement {measurement!r} was stored without its raw record")
             d = f[f"raw/{measurement}"]
@@ -323,13 +388,11 @@ class Store:
         if sha256 is None and record is not None:
             import hashlib
             sha256 = hashlib.sha256(np.ascontiguousarray(record.data).tobytes()).hexdigest()
-        mid = f"m{len(self._meas) + 1:07d}"
+        mid = f"m{self.n_measurements + 1:07d}"
         row = {"id": mid, "asset": asset, "point": point, "time": t, "rpm": None if rpm is None else float(rpm),
                "sha256": sha256, "file": file, "raw": bool(keep_raw and record is not None), "meta": meta or {}}
         self._pending["measurements"].append(row)
-        self._meas[mid] = row
-        if sha256:
-            self._hashes[sha256] = mid
+        self._pending_meas[mid] = row
         if keep_raw and record is not None:
             self._raw_pending[mid] = record
         return mid
@@ -342,7 +405,7 @@ class Store:
         self._need_writable()
         from .. import __version__
         from ..core.results import _jsonable
-        if measurement not in self._meas:
+        if not self._known(measurement):
             raise ParameterError(f"measurement={measurement!r} is not in the store")
         row = _jsonable({"measurement": measurement, "task": _check_name(task, "task"), "version": __version__,
                          "params": params or {}, "summary": summary or {}, "result": result})
@@ -393,15 +456,20 @@ class Store:
                     d.attrs["channels"] = json.dumps([{"name": c.name, "quantity": c.quantity, "unit": c.unit,
                                                        "location": c.location} for c in rec.channels])
             seal(tmp)
-        n0 = len(self._rows["results"])
-        for i, r in enumerate(self._pending["results"]):  # committed: the payload is read back when asked for
-            r["result"], r["_row"] = None, n0 + i
+        n0 = self._n["measurements"]
+        new = [(_hash_key(r["sha256"]), n0 + i) for i, r in enumerate(self._pending["measurements"]) if r.get("sha256")]
+        if new:  # committed rows leave memory; their hashes join the sorted index
+            keys = np.concatenate([self._hash_keys, np.array([k for k, _ in new], np.uint64)])
+            order = np.argsort(keys, kind="stable")
+            self._hash_keys = keys[order]
+            self._hash_rows = np.concatenate([self._hash_rows, np.array([r for _, r in new], np.int64)])[order]
         for k in TABLES:
-            self._rows[k] += self._pending[k]
+            self._n[k] += len(self._pending[k])
             self._pending[k] = []
+        self._pending_meas = {}
         self._raw_pending = {}
 
     def __repr__(self) -> str:
-        n = {k: len(self._rows[k]) + len(self._pending[k]) for k in TABLES}
+        n = {k: self._n[k] + len(self._pending[k]) for k in TABLES}
         return (f"Store({str(self.path)!r}: {n['assets']} assets, {n['points']} points, {n['measurements']} "
                 f"measurements, {n['results']} results{'; writable' if self.writable else ''})")

@@ -303,22 +303,20 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
     try:
         errs = st.errors()
         failures = dict(zip(errs["measurement"], errs["message"])) if "message" in errs else {}
-        known = bool(st._hashes)  # an empty store has nothing to skip: no need to hash every input twice
+        known = st.n_measurements > 0  # an empty store has nothing to skip: no need to hash every input twice
         for it in items:
             sha = None
             if not force and known:
                 try:
                     sha = file_sha256(it["file"])
                 except OSError as exc:
-                    rows.append({"file": it["file"], "status": "error", "measurement": None, "message": str(exc)})
+                    rows.append((it["file"], "error", None, str(exc)))
                     continue
             mid = st.has(sha) if sha else None
             if mid is not None:
                 failed = failures.get(mid)
-                rows.append({"file": it["file"], "status": "skipped", "measurement": mid,
-                             "message": "already in the store (same content)" +
-                                        (f"; it failed then: {failed}" if failed else "") +
-                                        "; force=True to analyse again"})
+                rows.append((it["file"], "skipped", mid, "already in the store (same content)" +
+                             (f"; it failed then: {failed}" if failed else "") + "; force=True to analyse again"))
             else:
                 todo.append(it)
         total = len(todo)
@@ -329,8 +327,7 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
             nonlocal done, committed, last_commit
             mid = _store_one(st, out, tasks, keep_raw, options)
             err = "; ".join(f"{k}: {v}" for k, v in out["errors"].items())
-            rows.append({"file": out["item"]["file"], "status": "error" if err else "done", "measurement": mid,
-                         "message": err})
+            rows.append((out["item"]["file"], "error" if err else "done", mid, err))  # a short row per input
             done += 1
             if progress is not None:
                 progress(done, total)
