@@ -7,6 +7,7 @@ cores) and the client's peak resident memory after each run (it must not grow wi
 records: results are committed and dropped as they arrive).
 
     python benchmarks/batch.py [N]          (N records, default 1000; about 2 minutes per 1000 on 2 cores)
+    python benchmarks/batch.py --memory N   (the serial batch only, the client's RSS every N/12 records)
 """
 
 import resource
@@ -112,7 +113,24 @@ def parallel_ceiling(item):
     return 2 * one / two
 
 
+def memory(n):
+    """The client's RSS over a long serial batch: flat once the first records are in (bounded)."""
+    warnings.simplefilter("ignore")
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp)
+        man = make(d, n)
+        clock = Clock()
+        vm.batch(task="spectrum+diagnose", store=d / "serial.h5", manifest=man, progress=clock)
+        print(f"client RSS during a serial batch of {n} records:")
+        for k in range(0, len(clock.rss), max(1, len(clock.rss) // 12)):
+            print(f"  after {clock.rss[k][0]:6d} records {clock.rss[k][1] / 1024:7.1f} MB")
+        slope, rise = clock.growth()
+        print(f"  slope over the second half {slope:+.2f} kB per record ({rise / 1024:+.1f} MB); target: bounded")
+
+
 def main():
+    if sys.argv[1:2] == ["--memory"]:
+        return memory(int(sys.argv[2]) if len(sys.argv) > 2 else 3000)
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
     warnings.simplefilter("ignore")
     with tempfile.TemporaryDirectory() as tmp:
