@@ -370,6 +370,22 @@ def test_amplitudes_whose_powers_leave_double_precision_are_refused(call, match)
         call()
 
 
+def test_psd_checks_the_amplitude_range_on_its_result():
+    # psd checks its powers, not every sample: amplitudes inside 1e-150..1e150 give the scaled
+    # spectrum (P(a x) = a^2 P(x) to rounding on the lines within 60 dB of the peak; further down, at
+    # 1e-149, the powers are subnormal numbers), outside it the same named error as everywhere
+    x = np.sin(0.3 * np.arange(8192.0))
+    ref = vm.psd(vm.Record.from_array(x, fs=100.0)).values
+    near = ref > 1e-6 * ref.max()
+    for a in (1e-149, 1e149):
+        got = vm.psd(vm.Record.from_array(a * x, fs=100.0)).values
+        assert np.allclose(got[near] / a ** 2, ref[near], rtol=1e-12, atol=0)
+    for a in (1e151, 1e-151):
+        with pytest.raises(vm.ParameterError, match="outside 1e-150..1e\\+150"):
+            vm.psd(vm.Record.from_array(a * x, fs=100.0))
+    assert not vm.psd(vm.Record.from_array(np.zeros(8192), fs=100.0)).values.any()  # zeros: a zero spectrum
+
+
 def test_negative_damping_is_refused_in_every_model():
     M, K = np.eye(2), np.array([[2.0, -1], [-1, 2]]) * 1e4
     with pytest.raises(vm.ParameterError, match="rayleigh"):

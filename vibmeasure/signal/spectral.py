@@ -44,14 +44,17 @@ class _ArraySource:
         return self.rec.data[:, start:stop]
 
 
-def _source(rec, fs=None):
+def _source(rec, fs=None, *, check: bool = True):
+    """The record as a source of blocks; ``check=False`` leaves the amplitude-range check to the
+    caller (psd checks its result instead, which saves a pass over the data)."""
     from ..core._validate import as_record
     from ..io.lazy import LazyRecord
     from ..core._validate import check_range
     if isinstance(rec, LazyRecord):
         return rec
     rec = as_record(rec, fs=fs)
-    check_range(rec.data)
+    if check:
+        check_range(rec.data)
     return _ArraySource(rec)
 
 
@@ -169,7 +172,12 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
         lines = slice(int(lines[0]), int(lines[-1]) + 1)   # contiguous lines: a view, not a gather
 
     def work(segs, chunks, s0):
-        """Sums over the segment batches this thread takes from the shared chunk iterator."""
+        """Sums over the segment batches this thread takes from the shared chunk iterator (powers
+        that overflow become inf, found after the block: no numpy warning on the way)."""
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            return _work(segs, chunks, s0)
+
+    def _work(segs, chunks, s0):
         au = np.zeros((n_ch, 2 * nf)) if reducer == "sum" else np.full((n_ch, nf), -np.inf)
         cr = np.zeros((len(pairs), nf), complex)
         buf = np.empty((BATCH, nperseg), dtype)           # one windowed batch, reused (no allocation per batch)
@@ -248,6 +256,8 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
                 bad = bad[0]
                 raise ParameterError(f"channel {names[idx[bad[0]]]!r} has NaN/inf at sample {a0 + bad[1]}; the rule "
                                      "is finite data: repair or cut the record first")
+            from ..core._validate import check_range
+            check_range(block)  # names the peak amplitude when it is outside the range allowed everywhere
             raise ParameterError("the spectrum's power overflows double precision: the samples are too large for "
                                  "this segment length; rescale the record (choose another unit)")
         if progress is not None:
@@ -325,7 +335,7 @@ def psd(rec, *, nperseg: int | None = None, noverlap: int | None = None, window=
     single precision (half the memory and FFT work; about 1e-6 relative error): use it for float32
     recordings whose dynamic range is below about 120 dB. The default is float64.
     """
-    src = _source(rec, fs)
+    src = _source(rec, fs, check=False)
     dtype = _check_dtype(dtype)
     nperseg, noverlap, nfft = _check_params(src.n_samples, nperseg, noverlap, nfft, detrend, average, 4096)
     if scaling not in ("density", "spectrum"):
@@ -334,6 +344,12 @@ def psd(rec, *, nperseg: int | None = None, noverlap: int | None = None, window=
     win = get_window(window, nperseg)
     P, nseg = _averaged_power(src, idx, nperseg=nperseg, noverlap=noverlap, nfft=nfft, win=win, detrend=detrend,
                               average=average, progress=progress, dtype=dtype)
+    top = P.max(axis=1) if P.size else np.zeros(1)
+    if isinstance(src, _ArraySource) and not np.all((top > 1e-250) & (top < 1e250)):
+        # powers near the ends of double precision: only then are the samples searched (amplitudes
+        # within 1e-150..1e150 are allowed, as everywhere; a record of zeros is a zero spectrum)
+        from ..core._validate import check_range
+        check_range(src.rec.data[idx])
     scale = 1.0 / (src.fs * (win @ win)) if scaling == "density" else 1.0 / win.sum() ** 2
     P = _one_sided(P * scale, nfft)
     ch, unit, q = _meta(src, idx)
