@@ -316,7 +316,6 @@ class Store:
 
     def record(self, measurement: str):
         """The raw record stored with a measurement (``keep_raw=True``)."""
-        import h5py
         from ..core.record import Channel, Record
         if measurement in self._raw_pending:
             return self._raw_pending[measurement]
@@ -458,11 +457,13 @@ class Store:
             seal(tmp)
         n0 = self._n["measurements"]
         new = [(_hash_key(r["sha256"]), n0 + i) for i, r in enumerate(self._pending["measurements"]) if r.get("sha256")]
-        if new:  # committed rows leave memory; their hashes join the sorted index
-            keys = np.concatenate([self._hash_keys, np.array([k for k, _ in new], np.uint64)])
-            order = np.argsort(keys, kind="stable")
-            self._hash_keys = keys[order]
-            self._hash_rows = np.concatenate([self._hash_rows, np.array([r for _, r in new], np.int64)])[order]
+        if new:  # committed rows leave memory; their hashes join the sorted index (a merge, O(n))
+            k_new = np.array([k for k, _ in new], np.uint64)
+            r_new = np.array([r for _, r in new], np.int64)
+            o = np.argsort(k_new, kind="stable")
+            at = np.searchsorted(self._hash_keys, k_new[o], side="right")  # after equal keys: latest last
+            self._hash_keys = np.insert(self._hash_keys, at, k_new[o])
+            self._hash_rows = np.insert(self._hash_rows, at, r_new[o])
         for k in TABLES:
             self._n[k] += len(self._pending[k])
             self._pending[k] = []
