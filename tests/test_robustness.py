@@ -384,6 +384,9 @@ def test_psd_checks_the_amplitude_range_on_its_result():
         with pytest.raises(vm.ParameterError, match="outside 1e-150..1e\\+150"):
             vm.psd(vm.Record.from_array(a * x, fs=100.0))
     assert not vm.psd(vm.Record.from_array(np.zeros(8192), fs=100.0)).values.any()  # zeros: a zero spectrum
+    # each channel is judged on its own: a normal channel beside it does not hide a tiny one
+    with pytest.raises(vm.ParameterError, match="channel 'b' peaks at 1e-160"):
+        vm.psd(vm.Record.from_array(np.vstack([x, 1e-160 * x]), fs=100.0, names=["a", "b"]))
 
 
 def test_negative_damping_is_refused_in_every_model():

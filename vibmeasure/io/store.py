@@ -35,7 +35,7 @@ TABLES = ("assets", "points", "measurements", "results")
 TASK_ALIASES = {"diagnosis": "diagnose", "modal": "modes", "spectra": "spectrum", "comparison": "compare"}
 
 
-def _hash_key(sha256: str) -> int:
+def _hash_key(sha256: str) -> np.uint64:
     """The first 64 bits of a hex SHA-256: the in-memory index key (8 bytes per measurement)."""
     try:
         return np.uint64(int(sha256[:16], 16))

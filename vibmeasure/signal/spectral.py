@@ -344,12 +344,12 @@ def psd(rec, *, nperseg: int | None = None, noverlap: int | None = None, window=
     win = get_window(window, nperseg)
     P, nseg = _averaged_power(src, idx, nperseg=nperseg, noverlap=noverlap, nfft=nfft, win=win, detrend=detrend,
                               average=average, progress=progress, dtype=dtype)
-    top = P.max(axis=1) if P.size else np.zeros(1)
-    if isinstance(src, _ArraySource) and not np.all((top > 1e-250) & (top < 1e250)):
-        # powers near the ends of double precision: only then are the samples searched (amplitudes
-        # within 1e-150..1e150 are allowed, as everywhere; a record of zeros is a zero spectrum)
+    if isinstance(src, _ArraySource):
+        # a channel whose powers are near the ends of double precision: only then are its samples
+        # searched (amplitudes within 1e-150..1e150 are allowed, as everywhere; zeros give zeros)
         from ..core._validate import check_range
-        check_range(src.rec.data[idx])
+        for k in np.flatnonzero(~((P.max(axis=1) > 1e-250) & (P.max(axis=1) < 1e250))):
+            check_range(src.rec.data[idx[k]], what=f"channel {src.channels[idx[k]].name!r}")
     scale = 1.0 / (src.fs * (win @ win)) if scaling == "density" else 1.0 / win.sum() ** 2
     P = _one_sided(P * scale, nfft)
     ch, unit, q = _meta(src, idx)
