@@ -54,9 +54,10 @@ def test_ssi_finds_every_mode(chain):
 
 
 def test_ssi_std_calibration_small_monte_carlo():
-    # 8 seeds x 5 modes: the zeta errors normalised by the stated std have an RMS between 0.4 and 1.6
-    # (1 would be exact; with 40 samples the RMS itself scatters by about 11 %, and the benchmark
-    # shows the jackknife is conservative for the weaker modes)
+    # 8 seeds x 5 modes: the zeta errors normalised by the stated std have an RMS within 0.7-1.4
+    # (1 would be exact; the issue asks for agreement within 30 %, and with 40 samples the RMS itself
+    # scatters by about 11 %: 1 +- (0.3 + 0.1). Measured 0.99; the mean over orders gave about 0.6 on
+    # the three upper modes, which this bound refuses)
     model, sensors = system()
     truth = model.modes()
     z = []
@@ -66,7 +67,7 @@ def test_ssi_std_calibration_small_monte_carlo():
         i = _matched(truth, est)
         z.extend((est.zeta[i] - truth.zeta) / est.zeta_std[i])
     rms = float(np.sqrt(np.mean(np.square(z))))
-    assert 0.4 < rms < 1.6
+    assert 0.7 < rms < 1.4
 
 
 def test_fdd_finds_every_mode(chain):
