@@ -56,8 +56,7 @@ def test_ssi_finds_every_mode(chain):
 def test_ssi_std_calibration_small_monte_carlo():
     # 8 seeds x 5 modes: the zeta errors normalised by the stated std have an RMS within 0.7-1.4
     # (1 would be exact; the issue asks for agreement within 30 %, and with 40 samples the RMS itself
-    # scatters by about 11 %: 1 +- (0.3 + 0.1). Measured 0.99; the mean over orders gave about 0.6 on
-    # the three upper modes, which this bound refuses)
+    # scatters by about 11 %: 1 +- (0.3 + 0.1). Measured 0.99)
     model, sensors = system()
     truth = model.modes()
     z = []
