@@ -71,7 +71,7 @@ def summarise(name, rows, truth, times):
     found = np.array([[j >= 0 for j in r["idx"]] for r in rows])
     print(f"\n{name}: {len(rows)} records, modes found {int(found.sum())} of {found.size}; "
           f"median time {statistics.median(times):.3f} s")
-    print("  mode    fn true  worst|dfn| %  bias %   zeta true  zeta RMSE  mean stated std  ratio  worst MAC")
+    print("  mode    fn true  worst|dfn| %  bias %   zeta true  zeta bias %  zeta RMSE  mean stated std  ratio  worst MAC")
     for m in range(nm):
         sel = [(r["fn"][r["idx"][m]], r["zeta"][r["idx"][m]], r["zeta_std"][r["idx"][m]], r["mac"][m])
                for r in rows if r["idx"][m] >= 0]
@@ -82,8 +82,9 @@ def summarise(name, rows, truth, times):
         err = (f - truth.fn[m]) / truth.fn[m] * 100
         rmse = float(np.sqrt(np.mean((z - truth.zeta[m]) ** 2)))
         std = float(np.nanmean(zs))
+        zbias = (np.mean(z) / truth.zeta[m] - 1) * 100
         print(f"  {m + 1:4d}  {truth.fn[m]:9.4f}   {np.max(np.abs(err)):10.3f}  {np.mean(err):+7.3f}   "
-              f"{truth.zeta[m]:9.4f}  {rmse:9.5f}  {std:15.5f}  {rmse / std:5.2f}  {np.min(mc):9.4f}")
+              f"{truth.zeta[m]:9.4f}  {zbias:+11.2f}  {rmse:9.5f}  {std:15.5f}  {rmse / std:5.2f}  {np.min(mc):9.4f}")
 
 
 N_PYOMA = 10   # pyOMA2 takes about 10 s per record here: the first 10 seeds
