@@ -50,6 +50,7 @@ def test_ssi_finds_every_mode(chain):
     assert np.all(mac >= 0.99)
     assert np.all(np.array(est.extras["mpc"]) > 0.95)
     assert est.extras["std_method"].startswith("block jackknife")
+    assert not any("near_harmonic" in f for f in est.mode_flags)   # modes are the peaks of their bands
     assert {row[3] for row in est.extras["stabilisation"]} >= {"o", "s"}
 
 
@@ -156,6 +157,16 @@ def test_real_mpstd_peaks_are_harmonics():
     for f in (182.0, 185.0):
         assert f in rej and rej[f]["kurtosis"] < 2.0 and "harmonic" in rej[f]["reason"]
     assert not np.any(np.abs(est.fn - 181.7) < 0.3) and not np.any(np.abs(est.fn - 184.8) < 0.3)
+    # SSI fits a pole in the valley between the 181.7 and 182.8 Hz lines (zeta 0.08 %): it is reported,
+    # flagged near_harmonic, with the sinusoids beside it (kurtosis 1.5-1.7, 15-22 dB above the pole)
+    with pytest.warns(vm.QualityWarning, match="near_harmonic"):
+        ssi = vm.oma_ssi(rec, band=(150, 220))
+    for k in range(ssi.n_modes):
+        if abs(ssi.fn[k] - 182.5) < 1.5:
+            assert "near_harmonic" in ssi.mode_flags[k]
+            tones = ssi.extras["near_harmonics"][k]
+            assert any(abs(t["f_hz"] - 181.7) < 0.2 for t in tones)
+            assert all(t["kurtosis"] < 2.2 and t["above_pole_db"] >= 10 for t in tones)
 
 
 def test_bad_input():

@@ -330,6 +330,28 @@ def _jackknife(S, cnt, s, l, fs, reps, V, sv):
     return out[:, 0], out[:, 1]
 
 
+def _tones_near(Y, fs, f_psd, p_psd, fn, zeta, phi) -> list:
+    """Harmonics beside a pole: peaks of the mean output PSD within max(5 zeta fn, 5 lines) of it that
+    stand 10 dB above the PSD at the pole and whose band is a sinusoid (band kurtosis below
+    TONE_KURTOSIS). A pole in the valley between strong harmonics is likely fitted to them; a mode
+    under random excitation is itself the peak of its band."""
+    df = f_psd[1]
+    reach = max(5 * zeta * fn, 5 * df)
+    sel = np.flatnonzero(np.abs(f_psd - fn) <= reach)
+    if sel.size < 3:
+        return []
+    at_pole = float(np.interp(fn, f_psd, p_psd))
+    out = []
+    for i in sel:
+        if 0 < i < p_psd.size - 1 and p_psd[i] >= p_psd[i - 1] and p_psd[i] >= p_psd[i + 1] \
+                and p_psd[i] >= 10 * at_pole:
+            k = band_kurtosis(Y, fs, f_psd[i], max(df, 10 * fs / Y.shape[1]), phi)
+            if k < TONE_KURTOSIS:
+                out.append({"f_hz": float(f_psd[i]), "kurtosis": float(k),
+                            "above_pole_db": float(10 * np.log10(p_psd[i] / at_pole))})
+    return out
+
+
 def _psd_overlay(Y, fs):
     """Mean auto-PSD of the outputs, for the stabilisation plot."""
     from scipy.signal import welch
@@ -445,7 +467,11 @@ def _ssi_estimate(rec, Y, names, modes, reps, fn_std, zeta_std, table, info):
             fl.append("close_modes")
         flags.append(tuple(fl))
     f_psd, p_psd = _psd_overlay(Y, rec.fs)
-    extras = dict(info, stabilisation=table, kurtosis=[rp["kurtosis"] for rp in reps], mpc=mpc(phi).tolist(), mpd=mpd(phi).tolist(), outputs=names,
+    near = [_tones_near(Y, rec.fs, f_psd, p_psd, fn[k], zeta[k], reps[k]["phi"]) for k in range(fn.size)]
+    for k, tones in enumerate(near):
+        if tones:
+            flags[k] = flags[k] + ("near_harmonic",)
+    extras = dict(info, stabilisation=table, near_harmonics=near, kurtosis=[rp["kurtosis"] for rp in reps], mpc=mpc(phi).tolist(), mpd=mpd(phi).tolist(), outputs=names,
                   cluster_size=[len(c["members"]) for c in modes], cluster_spread_fn_hz=spread_f,
                   cluster_spread_zeta=spread_z, model_order=[rp["order"] for rp in reps],
                   poles=[[float(l.real), float(l.imag)] for l in lam],
@@ -456,6 +482,12 @@ def _ssi_estimate(rec, Y, names, modes, reps, fn_std, zeta_std, table, info):
                             "max_zeta": MAX_ZETA})
     est = ModalEstimate(fn=fn, zeta=zeta, fn_std=fn_std, zeta_std=zeta_std, method="oma_ssi", mode_flags=tuple(flags),
                         shapes=phi, unit=rec.channels[0].unit, extras=extras)
+    for k, tones in enumerate(near):
+        if tones:
+            warn_quality(f"oma_ssi: the mode at {fn[k]:.5g} Hz sits among harmonics (sinusoids at "
+                         + ", ".join(f"{t['f_hz']:.5g} Hz (kurtosis {t['kurtosis']:.2f})" for t in tones)
+                         + ") that stand 10 dB or more above the spectrum at the pole: it may be a pole fitted to "
+                         "them, not a mode; flagged near_harmonic", stacklevel=3)
     if "few_cycles" in est.flags:
         warn_quality(f"oma_ssi: mode(s) with fewer than {MIN_CYCLES} cycles in the record: damping is poorly "
                      "determined; record longer", stacklevel=3)
