@@ -259,6 +259,7 @@ def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper):
 def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg, Gg):
     fn, zeta, fn_std, zeta_std, flags, bells = [], [], [], [], [], []
     power = POWER.get(rec.channels[0].quantity, 0)
+    kept = []
     for c in picked:
         bell, lines = _bell(S, U, c, mac_bell)
         fl, bias = [], None
@@ -275,6 +276,12 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
             vals = (e.fn[0], e.zeta[0], *stds)
             fl += [x for x in e.flags if x in ("few_cycles", "low_snr")]
         except (FitError, ParameterError) as err:
+            if getattr(err, "tones_hz", None):
+                # the bell's correlation function does not decay: a harmonic, which the kurtosis test
+                # passed because noise shares its band
+                rejected.append(dict(c, reason=f"a harmonic, not a mode: the EFDD correlation function does not "
+                                               f"decay (a stationary tone at {err.tones_hz[0]:.6g} Hz)"))
+                continue
             vals, end = (c["f"], np.nan, np.nan, np.nan), 0
             fl.append("efdd_failed")
             c["efdd_error"] = str(err)
@@ -287,6 +294,11 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
                       "decay_samples": int(end), "singular_value": c["sv"] + 1,
                       "bias_removed_fn_hz": None if bias is None else bias[0],
                       "bias_removed_zeta": None if bias is None else bias[1]})
+        kept.append(c)
+    if not kept:
+        raise FitError(f"oma_fdd: no mode in band={list(band)}: every peak is a harmonic "
+                       f"(rejected: {[(round(c['f'], 3), c['reason']) for c in rejected]})")
+    picked = kept
     phi = _normalise(np.column_stack([U[c["line"], :, c["sv"]] for c in picked]))
     show = (f >= max(0.0, band[0] - 0.1 * (band[1] - band[0]))) & (f <= band[1] + 0.1 * (band[1] - band[0]))
     extras = {"peaks": picked, "rejected_peaks": rejected, "bells": bells, "band_hz": list(band), "nperseg": nper,

@@ -457,7 +457,9 @@ def _nothing_to_report(d: _Decay, f: _Fit, c: _Modes):
                            "(a longer record, or less damping, is needed for fn and zeta)")
         if not c.tones.any():
             raise FitError("no decaying mode: only baseline wander or short transients stand out of the noise")
-        raise FitError(f"no decaying mode: only stationary tones at {np.round(fd_all[c.tones], 4).tolist()} Hz")
+        err = FitError(f"no decaying mode: only stationary tones at {np.round(fd_all[c.tones], 4).tolist()} Hz")
+        err.tones_hz = [float(v) for v in fd_all[c.tones]]   # callers (EFDD) tell a harmonic by it
+        raise err
     raise FitError("no decaying mode" + (f" inside band={d.band}" if d.band else "") + " stands out of the noise")
 
 
