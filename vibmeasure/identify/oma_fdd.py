@@ -5,6 +5,8 @@ The shared checks and shape measures are in :mod:`vibmeasure.identify.oma`."""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..core._threads import single_threaded
@@ -107,16 +109,18 @@ def _bell(S, U, cand, mac_bell):
     """The SDOF bell of one mode: at each line the singular value whose vector matches the peak's
     (MAC >= mac_bell), contiguous from the peak; zero elsewhere."""
     ref = U[cand["line"], :, cand["sv"]]
+    # MAC of every line's singular vectors with the peak's, (n_lines, n_sv), in one step
+    num = np.abs(np.einsum("j,ijk->ik", ref.conj(), U)) ** 2
+    den = np.maximum(np.einsum("ijk,ijk->ik", U.conj(), U).real * np.vdot(ref, ref).real, 1e-300)
+    mac = num / den
+    best = np.argmax(mac, axis=1)
+    ok = mac[np.arange(mac.shape[0]), best] >= mac_bell
     bell = np.zeros(S.shape[0])
     lines = []
     for step in (-1, 1):
         i = cand["line"] if step == 1 else cand["line"] - 1
-        while 0 <= i < S.shape[0]:
-            macs = [_mac(U[i, :, k], ref) for k in range(S.shape[1])]
-            k = int(np.argmax(macs))
-            if macs[k] < mac_bell:
-                break
-            bell[i] = S[i, k]
+        while 0 <= i < S.shape[0] and ok[i]:
+            bell[i] = S[i, best[i]]
             lines.append(i)
             i += step
     return bell, sorted(lines)
@@ -160,8 +164,7 @@ def _efdd_fit(bell, w, fs, nperseg):
     """Fit the bell's correlation function (a free decay) with the ring-down estimator."""
     from .ringdown import ringdown
     r = np.fft.irfft(bell)[:nperseg]
-    wac = np.correlate(w, w, mode="full")[nperseg - 1:]
-    wac = wac / wac[0]
+    wac = _window_autocorrelation(np.ascontiguousarray(w, float).tobytes())
     r = r / np.maximum(wac, 1e-12)
     r0 = r[0]
     env = np.abs(_analytic(r[: nperseg // 2]))
@@ -174,6 +177,17 @@ def _efdd_fit(bell, w, fs, nperseg):
         warnings.simplefilter("ignore", QualityWarning)
         est = ringdown(Record.from_array(r[:end] / r0, fs=fs, name="correlation"), n_modes=1, start=0.0)
     return est, end
+
+
+@functools.lru_cache(maxsize=8)
+def _window_autocorrelation(key: bytes) -> np.ndarray:
+    """The window's autocorrelation at lags 0..n-1, normalised to 1 at lag 0 (by FFT: the direct sum
+    took 9 ms per call at 8192 samples, called for every bell and jackknife replicate)."""
+    w = np.frombuffer(key, float)
+    n = w.size
+    W = np.fft.rfft(w, 2 * n)
+    wac = np.fft.irfft(np.abs(W) ** 2, 2 * n)[:n]
+    return wac / wac[0]
 
 
 def _analytic(x):
