@@ -129,6 +129,15 @@ def test_stationary_tone_is_not_a_mode():
     assert est.extras["tones_hz"] == [pytest.approx(50.0, rel=1e-5)]
 
 
+def test_only_a_tone_is_a_fit_error_that_names_it():
+    # a steady sinusoid in noise holds no decay: FitError, carrying the tone (EFDD tells a harmonic by it)
+    t = np.arange(20000) / 1000.0
+    x = np.sin(2 * np.pi * 50.0 * t) + np.random.default_rng(3).normal(0, 0.01, t.size)
+    with pytest.raises(vm.FitError, match="only stationary tones") as exc:
+        vm.ringdown(vm.Record.from_array(x, fs=1000.0))
+    assert exc.value.tones_hz == [pytest.approx(50.0, rel=1e-5)]
+
+
 def test_impact_with_force_channel_starts_after_the_pulse():
     fs, n = 2500.0, 10000
     t = np.arange(n) / fs

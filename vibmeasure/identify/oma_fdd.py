@@ -14,7 +14,7 @@ from ..core._validate import check_band
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.record import Record
 from ..core.results import ModalEstimate
-from .oma import N_GROUPS, TONE_KURTOSIS, _check_duration, _mac, _normalise, _outputs, band_kurtosis, mpc
+from .oma import MAX_REL_ZETA_STD, N_GROUPS, TONE_KURTOSIS, _check_duration, _mac, _normalise, _outputs, band_kurtosis, mpc
 
 __all__ = ["oma_fdd"]
 
@@ -138,8 +138,9 @@ def _efdd(bell, w, fs, nperseg, power=0):
     bell (on the OMA benchmark zeta was 5 % low on the 2 % mode). The same cut and fit on the exact SDOF
     bell at the estimate (f^power / |fn^2 - f^2 + 2i zeta fn f|^2, power 4 for accelerations) gives
     that bias; the (fn, zeta) whose cut-and-fitted exact bell reproduces the data's fit is found by a
-    few fixed-point steps. Returns (estimate, fitted samples, (dfn, dzeta) removed, or
-    None when the bias exceeds half of zeta: then the fit is kept as it is, and the caller flags it)."""
+    few fixed-point steps. Returns (estimate, fitted samples, (dfn, dzeta) removed, or None when
+    the bias exceeds half of zeta or the exact bell cannot be fitted: then the fit is kept as it is,
+    and the caller flags it)."""
     import dataclasses
     est, end = _efdd_fit(bell, w, fs, nperseg)
     k = np.flatnonzero(bell)
@@ -150,7 +151,10 @@ def _efdd(bell, w, fs, nperseg, power=0):
         # the (fn, zeta) whose exact bell, cut and fitted the same way, gives what the data gave
         exact = np.zeros(bell.size)
         exact[k] = fk ** power / ((fn ** 2 - fk ** 2) ** 2 + (2 * z * fn * fk) ** 2)
-        sim, _ = _efdd_fit(exact, w, fs, nperseg)
+        try:
+            sim, _ = _efdd_fit(exact, w, fs, nperseg)
+        except (FitError, ParameterError):
+            return est, end, None   # the exact bell's decay cannot be fitted: keep the fit, flagged
         step_f, step_z = fn0 - float(sim.fn[0]), z0 - float(sim.zeta[0])
         fn, z = fn + step_f, z + step_z
         if not (z > 0 and abs(z - z0) <= 0.5 * z0):
@@ -210,10 +214,14 @@ def oma_fdd(rec, *, band, nperseg: int | None = None, channels=None, n_modes: in
     mode's correlation function (a free decay), fitted by ``vm.ringdown`` for fn and zeta; the bias
     that cutting the bell leaves is found by the same cut and fit on the exact SDOF bell at the
     estimate and removed (``extras["bells"][k]["bias_removed_zeta"]``; a mode whose bias would exceed
-    half its zeta keeps the plain fit and is flagged ``bell_too_narrow``). Their stds come from a jackknife over 8 groups of segments (each left out, the decomposition and EFDD
-    repeated; the ring-down fit's own std where larger), or the ring-down fit's std alone (a lower
-    bound: it takes the correlation function's errors as white) when the record has fewer than 16
-    segments. Shapes are the singular vectors at the peaks.
+    half its zeta, or cannot be found, keeps the plain fit and is flagged ``bias_uncorrected``).
+    Their stds come from a jackknife over 8 groups of segments (each left out, the decomposition and
+    EFDD repeated; the ring-down fit's own std where larger), or the ring-down fit's std alone (a
+    lower bound: it takes the correlation function's errors as white) when the record has fewer than
+    16 segments. A peak whose correlation function does not decay (a stationary tone) or whose
+    damping's relative std exceeds 0.3 (the limit of oma_ssi, ringdown and fit_modes) is not a mode:
+    it goes to ``extras["rejected_peaks"]`` with the reason, and FitError lists them all when no mode
+    is left. Shapes are the singular vectors at the peaks.
     """
     Y, names = _outputs(rec, channels, "oma_fdd", 1)
     try:
@@ -281,7 +289,7 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
             e, end, bias = _efdd(bell, w, rec.fs, nper, power)
             jk = _efdd_jackknife(Gg, c, lines, U, mac_bell, w, rec.fs, nper) if Gg is not None else None
             if bias is None:
-                fl.append("bell_too_narrow")
+                fl.append("bias_uncorrected")
             elif jk is not None:
                 # the corrected estimate moves with the plain fit by about zeta / zeta_plain (the bias
                 # grows with zeta): the plain replicates' spread scaled by that slope
@@ -299,6 +307,11 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
             vals, end = (c["f"], np.nan, np.nan, np.nan), 0
             fl.append("efdd_failed")
             c["efdd_error"] = str(err)
+        if np.isfinite(vals[1]) and vals[3] > MAX_REL_ZETA_STD * vals[1]:
+            rejected.append(dict(c, zeta=float(vals[1]), zeta_std=float(vals[3]),
+                                 reason=f"damping relative std {vals[3] / vals[1]:.2f} > {MAX_REL_ZETA_STD}: the data "
+                                        "does not support the mode"))
+            continue
         if len(lines) < 5:
             fl.append("resolution_limited")
         for lst, v in zip((fn, zeta, fn_std, zeta_std), vals):
@@ -310,7 +323,7 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
                       "bias_removed_zeta": None if bias is None else bias[1]})
         kept.append(c)
     if not kept:
-        raise FitError(f"oma_fdd: no mode in band={list(band)}: every peak is a harmonic "
+        raise FitError(f"oma_fdd: no mode in band={list(band)} that the data supports "
                        f"(rejected: {[(round(c['f'], 3), c['reason']) for c in rejected]})")
     picked = kept
     phi = _normalise(np.column_stack([U[c["line"], :, c["sv"]] for c in picked]))
@@ -325,9 +338,10 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
                             "ring-down fit of the EFDD correlation function (white-error assumption: a lower bound)"}
     est = ModalEstimate(fn=fn, zeta=zeta, fn_std=fn_std, zeta_std=zeta_std, method="oma_fdd", mode_flags=tuple(flags),
                         shapes=phi, unit=rec.channels[0].unit, extras=extras)
-    if "bell_too_narrow" in est.flags:
-        warn_quality("oma_fdd: the bell of some mode(s) is too narrow for their damping (cutting it biases zeta by "
-                     "more than half): zeta is the uncorrected EFDD fit; lower mac_bell or use oma_ssi", stacklevel=3)
+    if "bias_uncorrected" in est.flags:
+        warn_quality("oma_fdd: the bias of cutting the bell could not be removed for some mode(s) (it would exceed "
+                     "half of zeta: the bell is too narrow for the damping, or the exact bell's decay could not be "
+                     "fitted): zeta is the plain EFDD fit, biased low; lower mac_bell or use oma_ssi", stacklevel=3)
     if "efdd_failed" in est.flags:
         warn_quality("oma_fdd: EFDD could not fit the decay of some mode(s): their damping is NaN (see "
                      "extras['peaks'][k]['efdd_error'])", stacklevel=3)
