@@ -374,8 +374,11 @@ def oma_ssi(rec, *, band=None, max_order: int = 40, block_rows: int | None = Non
     (at least 3) is a mode. fn and zeta are the cluster's medians over its orders; their stds come
     from a block jackknife of the output covariances (``n_blocks`` blocks, each replicate's estimate
     the median over the same orders). A mode whose damping's relative std exceeds 0.3 is not
-    reported (``extras["rejected_modes"]`` with the reason). Shapes (n_out, n_modes) are complex,
-    scaled to 1 at their largest component; MPC and MPD are in extras.
+    reported (``extras["rejected_modes"]`` with the reason); a mode whose band is a sinusoid (band
+    kurtosis below 2.2) neither. A mode in the valley between sinusoids that stand 10 dB above the
+    spectrum at its pole is reported with the flag ``near_harmonic`` (the sinusoids in
+    ``extras["near_harmonics"]``, and a QualityWarning). Shapes (n_out, n_modes) are complex, scaled to
+    1 at their largest component; MPC and MPD are in extras.
     """
     Y, names = _outputs(rec, channels, "oma_ssi", 2)
     l = Y.shape[0]
