@@ -23,6 +23,21 @@ def test_open_own_schema_and_stream_psd(tmp_path, rng, monkeypatch):
     assert lazy.load() == vm.read(p).replace(history=lazy.load().history)
 
 
+def test_read_into_a_buffer_equals_a_fresh_read(tmp_path, rng):
+    # the streamed PSD reads a file's blocks into two reused buffers (HDF5 converts float32 -> float64)
+    p = tmp_path / "f32.h5"
+    x = rng.normal(size=(3, 10_000)).astype(np.float32)
+    with h5py.File(p, "w") as f:
+        f.create_dataset("x", data=x, chunks=(3, 4096))
+    lazy = vm.open(p, dataset="x", fs=1000.0)
+    out = np.full((3, 2500), np.nan)
+    assert lazy.read(1000, 3500, out=out) is out
+    np.testing.assert_array_equal(out, lazy.read(1000, 3500))
+    np.testing.assert_array_equal(out, x[:, 1000:3500].astype(float))
+    with pytest.raises(vm.ParameterError, match="out must be a C-contiguous float64 array of shape \\(3, 2500\\)"):
+        lazy.read(1000, 3500, out=np.empty((3, 2400)))
+
+
 def test_open_bare_float32_dataset(tmp_path):
     p = tmp_path / "daq.h5"
     t = np.arange(200_000) / 10_000.0

@@ -73,14 +73,23 @@ class LazyRecord:
             raise ParameterError(f"channel={channel!r} is not in this record; channels are {self.names}")
         return self.names.index(channel)
 
-    def read(self, start: int, stop: int) -> np.ndarray:
-        """Samples start..stop of every channel as float64, shape (n_channels, stop - start)."""
+    def read(self, start: int, stop: int, out: np.ndarray | None = None) -> np.ndarray:
+        """Samples start..stop of every channel as float64, shape (n_channels, stop - start). ``out``,
+        a C-contiguous float64 array of exactly that shape, is filled instead of a new array (HDF5
+        converts the stored type on the way: no second copy, no fresh pages to fault in)."""
         start, stop = max(0, int(start)), min(self.n_samples, int(stop))
+        shape = (self.n_channels, stop - start)
+        if out is not None and (out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous):
+            raise ParameterError(f"out must be a C-contiguous float64 array of shape {shape}")
         with self._file() as f:
             d = f[self.dataset]
             try:
+                if out is not None:
+                    d.read_direct(out[0] if self._one_d else out, np.s_[start:stop] if self._one_d
+                                  else np.s_[:, start:stop])
+                    return out
                 a = d[start:stop] if self._one_d else d[:, start:stop]
-            except (OSError, ValueError) as exc:
+            except (OSError, ValueError, TypeError) as exc:
                 raise ParameterError(f"{str(self.path)!r}: samples {start}..{stop} are unreadable "
                                      f"(truncated file?): {exc}") from None
         a = np.asarray(a, dtype=np.float64)

@@ -229,14 +229,38 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
     autos = np.zeros((n_ch, nf)) if reducer == "sum" else np.full((n_ch, nf), -np.inf)
     crosses = np.zeros((len(pairs), nf), complex)
     pool = _pool()
-    for s0 in range(0, nseg, sb):
-        s1 = min(nseg, s0 + sb)
-        a0 = s0 * step
-        block = src.read(a0, (s1 - 1) * step + nperseg)
+    reads = [(s0, min(nseg, s0 + sb)) for s0 in range(0, nseg, sb)]
+
+    spare = []   # two float64 blocks a source on disk is read into, in turn (no fresh 16 MB per read)
+
+    def fetch(s0, s1):
+        a0, a1 = s0 * step, (s1 - 1) * step + nperseg
+        if spare and spare[0].shape[1] == a1 - a0:
+            buf = spare.pop(0)
+            block = src.read(a0, a1, out=buf)
+            spare.append(buf)   # handed out again two reads later, after this block is transformed
+        else:
+            block = src.read(a0, a1)
         if not all_rows:
             block = block[idx]
-        if block.dtype != dtype:
-            block = block.astype(dtype)
+        return block if block.dtype == dtype else block.astype(dtype)
+
+    # a source on disk: the next block is read by an I/O thread while this one is transformed (the
+    # read, the conversion to float and the first touch of the new block's pages release the GIL);
+    # at most two blocks are held, and only while a block is small enough that two fit the budget
+    ahead = (not isinstance(src, _ArraySource) and len(reads) > 1
+             and 2 * src.n_channels * READ_SAMPLES * 8 <= PREFETCH_BYTES)
+    io = _io_pool() if ahead else None
+    if io is not None:
+        spare += [np.empty((src.n_channels, (sb - 1) * step + nperseg)) for _ in range(2)]
+    nxt = io.submit(fetch, *reads[0]) if io is not None else None
+    for r, (s0, s1) in enumerate(reads):
+        a0 = s0 * step
+        if nxt is not None:
+            block = nxt.result()
+            nxt = io.submit(fetch, *reads[r + 1]) if r + 1 < len(reads) else None
+        else:
+            block = fetch(s0, s1)
         segs = np.lib.stride_tricks.as_strided(
             block, shape=(n_ch, s1 - s0, nperseg),
             strides=(block.strides[0], block.strides[1] * step, block.strides[1]), writeable=False)
@@ -271,6 +295,19 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
     return autos, crosses, nseg, per_seg
 
 
+PREFETCH_BYTES = 1 << 26   # two blocks of a source on disk are held (one read ahead) when they fit in this
+
+
+def _io_pool():
+    """One thread that reads the next block of a source on disk."""
+    global _IO_POOL
+    if _IO_POOL is None:
+        from concurrent.futures import ThreadPoolExecutor
+        _IO_POOL = ThreadPoolExecutor(max_workers=1, thread_name_prefix="vibmeasure-read")
+    return _IO_POOL
+
+
+_IO_POOL = None
 _POOL = None
 
 
