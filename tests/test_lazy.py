@@ -38,6 +38,22 @@ def test_read_into_a_buffer_equals_a_fresh_read(tmp_path, rng):
         lazy.read(1000, 3500, out=np.empty((3, 2400)))
 
 
+def test_a_block_that_fails_in_the_read_ahead_is_a_named_error(tmp_path, rng, monkeypatch):
+    # a compressed file damaged in its middle: the block the I/O thread reads ahead fails to decode,
+    # and the PSD raises the reader's ParameterError (range named), not a thread's traceback
+    p = tmp_path / "gz.h5"
+    with h5py.File(p, "w") as f:
+        f.create_dataset("x", data=rng.normal(size=400_000).astype(np.float32), chunks=(20_000,),
+                         compression="gzip")
+    size = p.stat().st_size
+    with open(p, "r+b") as f:
+        f.seek(int(size * 0.7))
+        f.write(b"\x00garbage" * 200)
+    monkeypatch.setattr(spectral, "READ_SAMPLES", 50_000)   # many blocks: the damage is read ahead
+    with pytest.raises(vm.ParameterError, match=r"samples \d+\.\.\d+ are unreadable"):
+        vm.psd(vm.open(p, dataset="x", fs=1000.0), nperseg=4096)
+
+
 def test_open_bare_float32_dataset(tmp_path):
     p = tmp_path / "daq.h5"
     t = np.arange(200_000) / 10_000.0

@@ -126,7 +126,7 @@ def _bell(S, U, cand, mac_bell):
     return bell, sorted(lines)
 
 
-BIAS_ITERATIONS = 4   # fixed-point steps of the bell-cut bias correction (on an exact bell: 0.05 % after 3)
+BIAS_ITERATIONS = 4   # fixed-point steps of the bell-cut bias correction (exact 57 Hz, 2 % bell: zeta to 0.011 %)
 POWER = {"displacement": 0, "velocity": 2, "acceleration": 4}   # an SDOF bell of each quantity: f^p |H|^2
 
 
