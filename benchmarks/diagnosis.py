@@ -46,7 +46,7 @@ def confusion(n):
                 rec = vm.synth.machine(fault=fault, snr_db=snr, seed=1000 * (snr + 100) + seed, duration=6.0)
                 d = vm.diagnose(rec, bearing="6205-2RS", gear=32)
                 counts[fault][SHORT.get(d.top, d.top)] += 1
-                calls.append((d.top, d.confidence, d.top == fault))
+                calls.append((d.top, d.confidence, d.top == fault, d.extras["score"]))
         correct = sum(counts[f][SHORT[f]] for f in FAULTS)
         false_alarms = n - counts["none"]["none"]
         print(f"\nSNR {snr} dB: correct {correct}/{n * len(FAULTS)} ({correct / (n * len(FAULTS)) * 100:.1f} %), "
@@ -62,16 +62,20 @@ def reliability(calls):
     for label, sel in (("fault calls", [c for c in calls if c[0] != "none"]),
                        ("'none' answers", [c for c in calls if c[0] == "none"])):
         print(f"  {label}:")
-        print(f"    {'confidence':>12} {'answers':>8} {'right':>8} {'mean conf':>10}")
-        for lo, hi in zip(BINS[:-1], BINS[1:]):
-            b = [c for c in sel if lo <= c[1] < hi]
-            if b:
-                print(f"    {lo:>5.2f}-{min(hi, 1):<5.2f} {len(b):>8} {np.mean([c[2] for c in b]):>8.2f} "
-                      f"{np.mean([c[1] for c in b]):>10.2f}")
-        low = [c for c in sel if c[1] < BINS[0]]
-        if low:
-            print(f"    {'< 0.50':>12} {len(low):>8} {np.mean([c[2] for c in low]):>8.2f} "
-                  f"{np.mean([c[1] for c in low]):>10.2f}")
+        for col, name in ((1, "confidence (calibrated)"), (3, "raw score (before calibration)")):
+            print(f"    by {name}:")
+            print(f"    {'bin':>12} {'answers':>8} {'right':>8} {'mean':>10}")
+            edges = [0.0] + BINS
+            for lo, hi in zip(edges[:-1], edges[1:]):
+                b = [c for c in sel if lo <= c[col] < hi]
+                if b:
+                    print(f"    {lo:>5.2f}-{min(hi, 1):<5.2f} {len(b):>8} {np.mean([c[2] for c in b]):>8.2f} "
+                          f"{np.mean([c[col] for c in b]):>10.2f}")
+        ece = [sum(abs(np.mean([c[2] for c in b]) - np.mean([c[col] for c in b])) * len(b)
+                   for lo, hi in zip([0.0] + BINS[:-1], BINS) if (b := [c for c in sel if lo <= c[col] < hi]))
+               / max(1, len(sel)) for col in (1, 3)]
+        print(f"    expected calibration error (answer-weighted |right - mean| over the bins): "
+              f"{ece[0]:.3f} calibrated, {ece[1]:.3f} raw score")
 
 
 def stress(n):

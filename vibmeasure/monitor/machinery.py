@@ -18,6 +18,7 @@ from ..core._validate import as_record, clean_signal, memory_guard, positive, re
 from ..core.errors import ParameterError
 from ..models.bearing import Bearing, Gear, bearing_from
 from .bearing_faults import FAMILIES, bearing_evidence
+from .calibration import calibrated
 
 __all__ = ["diagnose", "Diagnosis", "ISO_10816_3", "severity_zone"]
 
@@ -45,7 +46,9 @@ def severity_zone(v_rms_mm_s: float, *, group: int = 2, foundation: str = "rigid
 @dataclass(frozen=True)
 class Diagnosis:
     """``top`` (none, unbalance, misalignment, looseness, bearing_outer_race, bearing_inner_race,
-    bearing_ball, gear_mesh, resonance, electrical), its ``confidence`` and ``reason``; ``faults``
+    bearing_ball, gear_mesh, resonance, electrical), its ``confidence`` (the probability that the answer
+    is right, calibrated on synthetic machines: monitor/calibration.py; ``extras["score"]`` is the raw
+    evidence score it was mapped from) and ``reason``; ``faults``
     (table per fault family: evidence, p-value for bearing families, channel, pre-processing, band),
     ``speed`` (estimated rpm and consistency), ``severity`` (ISO zone), ``channel`` (where the top's
     evidence is), ``bearing_checked`` (False without a bearing), ``flags``; ``extras`` holds the bearing
@@ -65,7 +68,8 @@ class Diagnosis:
 
     def to_dict(self) -> dict:
         from ..core.results import _jsonable
-        return _jsonable({"top": self.top, "confidence": self.confidence, "reason": self.reason,
+        return _jsonable({"top": self.top, "confidence": self.confidence, "score": self.extras.get("score"),
+                          "reason": self.reason,
                           "channel": self.channel, "bearing_checked": self.bearing_checked,
                           "faults": self.faults.to_dict(orient="records"), "speed": self.speed,
                           "severity": self.severity, "envelope_band_hz": list(self.envelope_band_hz),
@@ -293,13 +297,15 @@ def _decide(table, job: _Job):
         best = calls.iloc[0]
         kin = [r for _, r in calls.iloc[1:].iterrows() if (r.fault in FAMILIES) == (best.fault in FAMILIES)]
         if not kin or best.confidence - kin[0].confidence >= 0.15:
-            top, conf = str(best.fault), float(best.confidence)
+            top, score = str(best.fault), float(best.confidence)
+            kind = "bearing" if top in FAMILIES else "shaft"
+            conf = calibrated(top, score, kind)
             also = [str(r.fault) for _, r in calls.iloc[1:].iterrows() if r.fault != top]
-            reason = f"{top}: {best.note} (confidence {conf:.2f})"
+            reason = f"{top}: {best.note} (confidence {conf:.2f}, score {score:.2f})"
             if also:
-                reason += f"; also above {TOP_CONFIDENCE}: {', '.join(also)}"
+                reason += f"; also scored above {TOP_CONFIDENCE}: {', '.join(also)}"
             channel = best.get("channel") if top in FAMILIES else job.primary
-            return top, conf, reason + checked, also, channel or job.primary
+            return top, conf, reason + checked, also, channel or job.primary, (kind, score)
         why = f"{best.fault} and {kin[0].fault} are equally likely"
     else:
         why = "no fault family stands out"
@@ -310,9 +316,9 @@ def _decide(table, job: _Job):
         b = bear.sort_values("log10_p").iloc[0]
         strongest = f"; strongest bearing candidate {b.fault} p = {b.p_value:.2g}"
     p_none = _p_none(table)
-    reason = (f"none: {why}; strongest candidate {cand.fault} at confidence {cand.confidence:.2f}"
+    reason = (f"none: {why}; strongest candidate {cand.fault} at score {cand.confidence:.2f}"
               f"{strongest}{checked}")
-    return "none", p_none, reason, [], job.primary
+    return "none", calibrated("none", p_none, "none"), reason, [], job.primary, ("none", p_none)
 
 
 def _p_none(table) -> float:
@@ -364,12 +370,12 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         rows.append(sf.gear_row(f, A, f1, job.gear, _line, _row, LINE_DB))
     import pandas as pd
     table = pd.DataFrame(rows).sort_values("confidence", ascending=False, ignore_index=True)
-    top, conf, reason, also, where = _decide(table, job)
+    top, conf, reason, also, where, (kind, score) = _decide(table, job)
     if "speed_inconsistent" in job.flags:
         reason += "; " + speed["note"]
     if job.bearing is None:
         job.flags.append("bearing_not_checked")
-    extras = {"also": also, "primary": job.primary}
+    extras = {"also": also, "primary": job.primary, "score": score, "confidence_kind": kind}
     env_band = ()
     if ev is not None:
         extras.update(_plot_material(ev, top))
