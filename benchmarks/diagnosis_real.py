@@ -154,6 +154,16 @@ def main(fault_channel_only=False):
           f"{len(outer)}; right {sum(r['vm'] == r['truth'] for r in strong)} of {len(strong)} (target: all)")
     for r in sorted(outer, key=lambda r: -r["bpfo_db"]):
         print(f"    {r['name']:28s} BPFO comb {r['bpfo_db']:5.1f} dB  vibmeasure {SHORT[r['vm']]}")
+    # the confidence map was learnt on synthetic machines: how it reads on real ones (every record)
+    print("\nconfidence on real records (all 57; the map was learnt on synthetic machines):")
+    print(f"    {'answer':>8} {'confidence':>12} {'answers':>8} {'right':>8} {'mean':>8}")
+    for kind, sel in (("fault", [r for r in rows if r["raw_top"] != "none"]),
+                      ("none", [r for r in rows if r["raw_top"] == "none"])):
+        for lo, hi in ((0.0, 0.5), (0.5, 0.9), (0.9, 0.99), (0.99, 1.01)):
+            b = [r for r in sel if lo <= r["conf"] < hi]
+            if b:
+                print(f"    {kind:>8} {lo:>5.2f}-{min(hi, 1):<5.2f} {len(b):>8} "
+                      f"{np.mean([r['raw_top'] == r['truth'] for r in b]):>8.2f} {np.mean([r['conf'] for r in b]):>8.2f}")
     print("\n=== cwru drive-end records ===")
     show("vm.diagnose", [r for r in rows if r["set"] == "cwru"], "vm")
     show("reference", [r for r in rows if r["set"] == "cwru"], "ref")
