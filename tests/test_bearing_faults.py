@@ -4,6 +4,7 @@ real recordings of ../shared/data (CWRU fan and drive end, MFPT) with the eviden
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 import scipy.io as sio
 
@@ -140,6 +141,22 @@ def test_development_set_scores(development_set):
     assert len(development_set) == 53
     assert wrong <= 2 and right >= 39
     assert all(d.top == t for t, d in development_set.values() if t == "bearing_inner_race")
+
+
+def test_a_none_names_why_its_strongest_candidate_was_not_called(development_set):
+    # B007_2 (fan-end ball fault, channel FE): a 2xBSF comb with p below ALPHA, but only one of its lines
+    # stands 7.8 dB above the floor and no +-FTF sideband does: the rule (two lines, the cage
+    # modulation of a ball defect) keeps it from a call, and the answer says which parts failed
+    truth, d = development_set["B007_2.mat"]
+    ball = d.faults.set_index("fault").loc["bearing_ball"]
+    assert truth == "bearing_ball" and d.top == "none"
+    assert ball.p_value < 1e-3
+    assert "1 line(s) stand 7.8 dB above the floor, 2 needed" in ball.not_called
+    assert "no +-FTF sidebands" in ball.not_called
+    assert f"strongest bearing candidate bearing_ball p = {ball.p_value:.2g} (not called: {ball.not_called})" in d.reason
+    # a family that was called has no such reason
+    truth, d = development_set["IR007_0.mat"]
+    assert d.top == truth and pd.isna(d.faults.set_index("fault").loc["bearing_inner_race"].not_called)
 
 
 @pytest.mark.parametrize("name", ["OR007@6_0.mat", "OR014@3_2.mat", "OR021@6_0.mat", "OuterRaceFault_vload_2.mat"])

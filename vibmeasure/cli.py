@@ -438,7 +438,7 @@ def _main_diagnose(args, out, err) -> int:
         for _, r in diag.faults.iterrows():
             p = r.get("p_value")
             extra = f"  p = {p:.2g} ({r.channel}, {r.preprocessing})" if p is not None and p == p and p < 1 else ""
-            print(f"  {r.fault:20s} expected {r.expected_hz:9.2f} Hz  confidence {r.confidence:.2f}{extra}", file=out)
+            print(f"  {r.fault:20s} expected {r.expected_hz:9.2f} Hz  score {r.confidence:.2f}{extra}", file=out)
     if args.plot:
         print(f"vibmeasure: wrote {args.plot}", file=err)
     return 0

@@ -433,7 +433,33 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
         # decoy combs the family beats on its own spectrum
         fams[n]["confidence"] = float(c * share * (1.0 - fams[n].get("decoy_p", 1.0)))
     fams["bearing_cage"]["confidence"] = 0.0
+    for n in names:
+        fams[n]["not_called"] = _not_called(n, fams[n], n_sp)
     return {"families": fams, "spectra": spectra, "kurtogram": kg, "n_spectra": n_sp}
+
+
+def _not_called(name: str, fam: dict, n_sp: int) -> str | None:
+    """Why a family with a comb was not called, in the terms of the decision rule (None when it was
+    called or has no comb at all)."""
+    if fam["found"] or fam["n_terms"] == 0:
+        return None
+    why = []
+    if fam["p_value"] >= 0.1:
+        why.append(f"no comb stands above the floor (p = {fam['p_value']:.2g})")
+    elif fam["log_p"] >= np.log(ALPHA):
+        why.append(f"p = {fam['p_value']:.3g} is not below {ALPHA:g} (corrected for the {n_sp} spectra, the slips "
+                   "and the sub-models searched)")
+    if fam["n_lines"] < 2:
+        why.append(f"{fam['n_lines']} line(s) stand {10 * np.log10(R_LINE):.1f} dB above the floor, 2 needed")
+    elif fam.get("n_carriers", 1) < 1:
+        why.append("no line at a harmonic of its own fundamental")
+    if fam.get("modulation_sidebands") == 0:
+        why.append("no +-1X sidebands (an inner-race defect turns through the load zone)"
+                   if name == "bearing_inner_race" else
+                   "no +-FTF sidebands (a ball defect travels with the cage)")
+    if not why and not fam["votes"]:
+        why.append("its lines are explained first by another family, the shaft harmonics or the cage comb")
+    return "; ".join(why) or None
 
 
 def _summary(name, key, res, ses, freqs, n_sp) -> dict:
@@ -455,6 +481,7 @@ def _summary(name, key, res, ses, freqs, n_sp) -> dict:
     return {"fault": name, "expected_hz": expected, "found": found, "log_p": logp, "p_value": float(np.exp(logp)),
             "statistic": res["stat"], "n_terms": res["n_terms"],
             "log10_p": float(logp / np.log(10)), "slip": res["slip"], "found_hz": float(f0),
-            "lines": lines, "n_lines": res["n_lines"], "channel": ses.channel, "preprocessing": ses.prep,
+            "lines": lines, "n_lines": res["n_lines"], "n_carriers": res["n_carriers"], "channel": ses.channel,
+            "preprocessing": ses.prep,
             "band_hz": ses.band, "model": res.get("model"), "modulation_sidebands": res.get("modulation"),
             "amplitude": float(ses.amp[i]) if i < ses.amp.size else None, "evidence_db": ev_db}

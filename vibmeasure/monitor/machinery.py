@@ -278,6 +278,7 @@ def _bearing_rows(job: _Job, f1: float, speed: dict):
                          note, p_value=s["p_value"], log10_p=s["log10_p"], statistic=s["statistic"],
                          n_terms=s["n_terms"], decoy_p=s.get("decoy_p"), slip=s["slip"], channel=s["channel"],
                          preprocessing=s["preprocessing"], band_hz=s["band_hz"], votes=s["votes"],
+                         not_called=s.get("not_called"),
                          harmonics=[{k: ln[k] for k in ("harmonic", "sideband", "hz", "db")} for ln in s["lines"]]))
     return rows, ev
 
@@ -315,9 +316,12 @@ def _decide(table, job: _Job):
     if len(bear):
         b = bear.sort_values("log10_p").iloc[0]
         strongest = f"; strongest bearing candidate {b.fault} p = {b.p_value:.2g}"
+        if isinstance(b.get("not_called"), str):
+            strongest += f" (not called: {b.not_called})"
     p_none = _p_none(table)
-    reason = (f"none: {why}; strongest candidate {cand.fault} at score {cand.confidence:.2f}"
-              f"{strongest}{checked}")
+    top_score = (f"strongest candidate {cand.fault} at score {cand.confidence:.2f}" if cand.confidence > 0
+                 else "every family scored 0")
+    reason = f"none: {why}; {top_score}{strongest}{checked}"
     return "none", calibrated("none", p_none, "none"), reason, [], job.primary, ("none", p_none)
 
 
