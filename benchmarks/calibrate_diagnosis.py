@@ -16,7 +16,6 @@ import warnings
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-
 import vibmeasure as vm
 from vibmeasure.monitor.calibration import TABLE, fit_isotonic
 
