@@ -7,7 +7,8 @@ wrong (a weak resonance at -10 dB) and fault calls scored 0.7-0.8 right half the
 
 The map from score to probability is learnt per answer (each fault name and "none"; answers the
 calibration set never gives, such as electrical, use the pooled map of their group, "shaft" or
-"bearing") by isotonic regression (pool-adjacent-violators) on synthetic machines that the benchmark does not use
+"bearing"), once with the bearing given and once without it (maps prefixed UNCHECKED: there a
+"none" also stands for every bearing fault it could not see), by isotonic regression (pool-adjacent-violators) on synthetic machines that the benchmark does not use
 (``benchmarks/calibrate_diagnosis.py`` regenerates ``data/diagnosis_calibration.csv``). It is
 monotone, so the answer's ranking is kept; each pooled block's rate carries a Beta(1, 1) prior, so a
 block of a few answers never says 0 or 1. The probabilities hold for the calibration set's mix: nine
@@ -25,9 +26,15 @@ import numpy as np
 
 from ..core.errors import ParameterError
 
-__all__ = ["calibrated", "fit_isotonic", "GROUPS"]
+__all__ = ["calibrated", "fit_isotonic", "GROUPS", "UNCHECKED", "NONE_SHAFT", "NONE_BEARING"]
 
 GROUPS = ("shaft", "bearing")
+UNCHECKED = "bearing not checked:"   # prefix of the maps learnt without a bearing (bearing faults unseen)
+# "none" with a bearing: its score's two parts (shaft-order, bearing) are mapped on their own, each to the
+# chance that no fault of its kind hides behind the answer, and the two multiplied. One map of their
+# product could not tell a healthy machine with a marginal bearing comb (p ~ 0.002) from a buried
+# resonance: both scored 0.77, and such answers were right 7 % of the time.
+NONE_SHAFT, NONE_BEARING = "none|shaft", "none|bearing"
 TABLE = Path(__file__).resolve().parents[1] / "data" / "diagnosis_calibration.csv"
 
 

@@ -18,7 +18,7 @@ from ..core._validate import as_record, clean_signal, memory_guard, positive, re
 from ..core.errors import ParameterError
 from ..models.bearing import Bearing, Gear, bearing_from
 from .bearing_faults import FAMILIES, bearing_evidence
-from .calibration import calibrated
+from .calibration import NONE_BEARING, NONE_SHAFT, UNCHECKED, calibrated
 
 __all__ = ["diagnose", "Diagnosis", "ISO_10816_3", "severity_zone"]
 
@@ -300,13 +300,14 @@ def _decide(table, job: _Job):
         if not kin or best.confidence - kin[0].confidence >= 0.15:
             top, score = str(best.fault), float(best.confidence)
             kind = "bearing" if top in FAMILIES else "shaft"
-            conf = calibrated(top, score, kind)
+            pre = "" if job.bearing is not None else UNCHECKED
+            conf = calibrated(pre + top, score, pre + kind)
             also = [str(r.fault) for _, r in calls.iloc[1:].iterrows() if r.fault != top]
             reason = f"{top}: {best.note} (confidence {conf:.2f}, score {score:.2f})"
             if also:
                 reason += f"; also scored above {TOP_CONFIDENCE}: {', '.join(also)}"
             channel = best.get("channel") if top in FAMILIES else job.primary
-            return top, conf, reason + checked, also, channel or job.primary, (kind, score)
+            return top, conf, reason + checked, also, channel or job.primary, (kind, score, None)
         why = f"{best.fault} and {kin[0].fault} are equally likely"
     else:
         why = "no fault family stands out"
@@ -318,24 +319,31 @@ def _decide(table, job: _Job):
         strongest = f"; strongest bearing candidate {b.fault} p = {b.p_value:.2g}"
         if isinstance(b.get("not_called"), str):
             strongest += f" (not called: {b.not_called})"
-    p_none = _p_none(table)
+    s_shaft, s_bear = _p_none(table)
+    p_none = s_shaft * s_bear
     top_score = (f"strongest candidate {cand.fault} at score {cand.confidence:.2f}" if cand.confidence > 0
                  else "every family scored 0")
     reason = f"none: {why}; {top_score}{strongest}{checked}"
-    return "none", calibrated("none", p_none, "none"), reason, [], job.primary, ("none", p_none)
+    if job.bearing is not None:  # each part mapped to the chance that no fault of its kind was missed
+        conf = calibrated(NONE_SHAFT, s_shaft, NONE_SHAFT) * calibrated(NONE_BEARING, s_bear, NONE_BEARING)
+    else:
+        conf = calibrated(UNCHECKED + "none", p_none, UNCHECKED + "none")
+    return "none", conf, reason, [], job.primary, ("none", p_none, {"shaft": s_shaft, "bearing": s_bear})
 
 
-def _p_none(table) -> float:
-    """Probability that none of the families is present: the shaft-order confidences and the bearing
-    families' posterior odds (from their p-values) taken as independent."""
+def _p_none(table) -> tuple[float, float]:
+    """The raw score of "none" in two parts, (shaft-order, bearing): the product of 1 - score over the
+    shaft-order families, and over the bearing families of 1 - their posterior from the p-value. The
+    score of "none" is their product; each part is calibrated on its own (monitor/calibration.py)."""
     from .bearing_faults import _log_p_to_conf
     shaft = table[table.fault.isin(SHAFT_FAULTS)].confidence.to_numpy()
-    p = float(np.prod(1 - shaft)) if shaft.size else 1.0
+    s_shaft = float(np.prod(1 - shaft)) if shaft.size else 1.0
     bear = table[table.fault.isin(list(FAMILIES))]
+    s_bear = 1.0
     if len(bear):
         c = _log_p_to_conf(bear.log10_p.to_numpy(float) * np.log(10))
-        p *= float(np.prod(1 - c))
-    return p
+        s_bear = float(np.prod(1 - c))
+    return s_shaft, s_bear
 
 
 @memory_guard
@@ -374,12 +382,14 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         rows.append(sf.gear_row(f, A, f1, job.gear, _line, _row, LINE_DB))
     import pandas as pd
     table = pd.DataFrame(rows).sort_values("confidence", ascending=False, ignore_index=True)
-    top, conf, reason, also, where, (kind, score) = _decide(table, job)
+    top, conf, reason, also, where, (kind, score, parts) = _decide(table, job)
     if "speed_inconsistent" in job.flags:
         reason += "; " + speed["note"]
     if job.bearing is None:
         job.flags.append("bearing_not_checked")
     extras = {"also": also, "primary": job.primary, "score": score, "confidence_kind": kind}
+    if parts is not None:
+        extras["score_parts"] = parts
     env_band = ()
     if ev is not None:
         extras.update(_plot_material(ev, top))
