@@ -87,3 +87,19 @@ def test_without_a_bearing_a_none_is_weak_evidence_of_health():
     # near 1 was right in every calibration machine: calibrated apart, the parts keep it confident
     parts = seen.extras["score_parts"]
     assert parts["shaft"] > 0.95 and parts["bearing"] < 0.8
+
+
+def test_report_flags_an_unlikely_none_for_a_look():
+    # the HTML report's verdict: a "none" below 0.5 (here the buried resonance of seed 90804, 0.04) is
+    # "watch", a confident one "ok"
+    from vibmeasure.reporting import diagnosis_section
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    classes = []
+    for fault in ("resonance", "none"):
+        rec = vm.synth.machine(fault=fault, snr_db=-10, seed=90804, duration=6.0)
+        d = vm.diagnose(rec, bearing="6205-2RS", gear=32)
+        assert d.top == "none"
+        sec = diagnosis_section(rec, d, fault)
+        classes.append(sec["verdict_class"])
+        assert f"(confidence {d.confidence:.2f})" in sec["verdict_text"]
+    assert classes == ["watch", "ok"]

@@ -134,7 +134,12 @@ def modes_section(frf, est, name):
 def diagnosis_section(rec, diag, name):
     from . import plot
     sev = diag.severity or {}
-    cls = "ok" if diag.top == "none" else "alarm" if diag.confidence >= 0.9 else "watch"
+    # a "none" that is probably wrong (an unexplained candidate, a weak fault it could not name) is
+    # worth a look, not a green light
+    if diag.top == "none":
+        cls = "ok" if diag.confidence >= 0.5 else "watch"
+    else:
+        cls = "alarm" if diag.confidence >= 0.9 else "watch"
     sec = {"kind": "diagnosis", "title": f"Machine diagnosis: {name}", "tables": [], "figures": [],
            "flags": _flags([f for f in diag.flags if f in FLAG_ADVICE]),
            "verdict": diag.top.replace("_", " "), "verdict_class": cls,
@@ -145,7 +150,7 @@ def diagnosis_section(rec, diag, name):
                      _fmt(r.get("evidence_db"), 3), _fmt(r.get("confidence"), 2), _fmt(r.get("log10_p"), 3),
                      r.get("note") or ""])
     sec["tables"].append({"caption": "Evidence per fault family", "header": ["fault", "expected [Hz]", "found [Hz]",
-                                                                            "evidence [dB]", "confidence",
+                                                                            "evidence [dB]", "score",
                                                                             "log10 p", "note"], "rows": rows})
     sec["tables"].append({"caption": "ISO 10816-3 severity", "header": ["velocity RMS [mm/s]", "band [Hz]", "group",
                                                                        "foundation", "zone"],
