@@ -5,15 +5,18 @@ its evidence ramp, "none" by the product of (1 - score) over every family. Those
 well but are not probabilities: on the synthetic benchmark, "none" answers scored 0.5-0.8 were all
 wrong (a weak resonance at -10 dB) and fault calls scored 0.7-0.8 right half the time.
 
-The map from score to probability is learnt per answer (each fault name and "none"; answers the
-calibration set never gives, such as electrical, use the pooled map of their group, "shaft" or
-"bearing"), once with the bearing given and once without it (maps prefixed UNCHECKED: there a
-"none" also stands for every bearing fault it could not see), by isotonic regression (pool-adjacent-violators) on synthetic machines that the benchmark does not use
-(``benchmarks/calibrate_diagnosis.py`` regenerates ``data/diagnosis_calibration.csv``). It is
-monotone, so the answer's ranking is kept; each pooled block's rate carries a Beta(1, 1) prior, so a
+The map from score to probability is learnt by isotonic regression (pool-adjacent-violators), one
+map per answer: each fault name; answers the calibration set never gives (electrical) use their
+group's pooled map ("shaft", "bearing"). A "none" with a bearing given has its score's two parts
+(shaft-order, bearing) mapped apart (NONE_SHAFT, NONE_BEARING) and multiplied. The maps are learnt
+once with the bearing given and once without it (prefix UNCHECKED: there a "none" also stands for
+every bearing fault it could not see). ``benchmarks/calibrate_diagnosis.py`` learns them on synthetic
+machines the benchmark does not use and writes ``data/diagnosis_calibration.csv``. Each map is
+monotone, so the answers keep their order; each pooled block's rate carries a Beta(1, 1) prior, so a
 block of a few answers never says 0 or 1. The probabilities hold for the calibration set's mix: nine
-kinds of machine in equal numbers (one healthy in nine), SNR -10 to 10 dB. A fleet where most machines
-are healthy makes a "none" more likely right than it says.
+kinds of machine in equal numbers (one healthy in nine) at SNR -10, 0 and 10 dB. On a fleet where
+most machines are healthy a "none" is right more often than it says; on real recordings a fault the
+envelope cannot show (the ball faults of the CWRU fan-end set) leaves a confident "none".
 """
 
 from __future__ import annotations
