@@ -103,3 +103,16 @@ def test_report_flags_an_unlikely_none_for_a_look():
         classes.append(sec["verdict_class"])
         assert f"(confidence {d.confidence:.2f})" in sec["verdict_text"]
     assert classes == ["watch", "ok"]
+
+
+@pytest.mark.parametrize("text, match", [(None, "missing or damaged"),
+                                         ("kind,score,probability\nnone,0.5,x\n", "missing or damaged"),
+                                         ("kind,score\nnone,0.5\n", "missing or damaged"),
+                                         ("kind,score,probability\nnone,0.5,0.2\nnone,0.4,0.3\n", "not increasing"),
+                                         ("kind,score,probability\nnone,0.5,1.2\n", "not increasing")])
+def test_a_missing_or_damaged_table_is_named(tmp_path, text, match):
+    path = tmp_path / "calibration.csv"
+    if text is not None:
+        path.write_text(text, encoding="utf-8")
+    with pytest.raises(vm.VibMeasureError, match=match):
+        _table(path)

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.errors import ParameterError
+from ..core.errors import ParameterError, VibMeasureError
 
 __all__ = ["calibrated", "fit_isotonic", "GROUPS", "UNCHECKED", "NONE_SHAFT", "NONE_BEARING"]
 
@@ -92,12 +92,22 @@ def _pav(blocks):
 
 
 @lru_cache(maxsize=1)
-def _table() -> dict:
+def _table(path: Path = TABLE) -> dict:
+    """The shipped maps {kind: (knots, rates)}; a missing or damaged table is named, not a traceback."""
     maps: dict = {}
-    with open(TABLE, newline="", encoding="utf-8") as fh:
-        for row in csv.DictReader(line for line in fh if not line.startswith("#")):
-            maps.setdefault(row["kind"], []).append((float(row["score"]), float(row["probability"])))
-    return {k: (np.array([a for a, _ in v]), np.array([b for _, b in v])) for k, v in maps.items()}
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            for row in csv.DictReader(line for line in fh if not line.startswith("#")):
+                maps.setdefault(row["kind"], []).append((float(row["score"]), float(row["probability"])))
+    except (OSError, KeyError, TypeError, ValueError) as exc:
+        raise VibMeasureError(f"the confidence calibration table {path} is missing or damaged ({exc}); reinstall "
+                              "vibmeasure or rewrite it with benchmarks/calibrate_diagnosis.py") from None
+    out = {k: (np.array([a for a, _ in v]), np.array([b for _, b in v])) for k, v in maps.items()}
+    for k, (knots, rates) in out.items():
+        if not (np.all(np.diff(knots) > 0) and np.all((rates >= 0) & (rates <= 1))):
+            raise VibMeasureError(f"the confidence calibration table {path} is damaged: the map {k!r} is not "
+                                  "increasing scores to probabilities in [0, 1]")
+    return out
 
 
 def calibrated(answer: str, score: float, group: str) -> float:
