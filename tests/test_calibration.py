@@ -55,9 +55,9 @@ def test_shipped_maps_are_monotone_probabilities():
 @pytest.mark.parametrize("seed", [90804, 90805, 90806])
 def test_none_on_a_buried_resonance_is_not_confident(seed):
     # a structural mode at 1.06 x 1X at -10 dB (seeds outside the calibration's 90500-90649 and the
-    # benchmark's 90000-90019): the raw "none" score is 0.5-0.75 (the resonance scored 0.25-0.5), and
-    # such "none" answers (score < 0.78) were wrong in 91 of 93 calibration machines: the confidence
-    # says so (< 0.1)
+    # benchmark's 90000-90019): the raw "none" score is 0.5-0.75 (a shaft-order family scored
+    # 0.25-0.5), and such "none" answers (score < 0.78) were wrong in 91 of 93 calibration machines:
+    # the confidence says so (< 0.1)
     warnings.simplefilter("ignore", vm.QualityWarning)
     d = vm.diagnose(vm.synth.machine(fault="resonance", snr_db=-10, seed=seed, duration=6.0), bearing="6205-2RS",
                     gear=32)
@@ -83,7 +83,7 @@ def test_without_a_bearing_a_none_is_weak_evidence_of_health():
     assert 0.1 < blind.confidence < 0.4 and seen.confidence > 0.95
     assert "bearing faults not checked" in blind.reason
     # this machine shows a marginal BPFO comb (p ~ 0.002, not called): the bearing part of its "none"
-    # score is 0.77, as low as a buried resonance's whole score, yet a "none" with its shaft-order part
+    # score is 0.75, as low as a buried resonance's whole score, yet a "none" with its shaft-order part
     # near 1 was right in every calibration machine: calibrated apart, the parts keep it confident
     parts = seen.extras["score_parts"]
     assert parts["shaft"] > 0.95 and parts["bearing"] < 0.8

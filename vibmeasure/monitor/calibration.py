@@ -36,7 +36,7 @@ UNCHECKED = "bearing not checked:"   # prefix of the maps learnt without a beari
 # "none" with a bearing: its score's two parts (shaft-order, bearing) are mapped on their own, each to the
 # chance that no fault of its kind hides behind the answer, and the two multiplied. One map of their
 # product could not tell a healthy machine with a marginal bearing comb (p ~ 0.002) from a buried
-# resonance: both scored 0.77, and such answers were right 7 % of the time.
+# resonance: both scored 0.75, and such answers were right 7 % of the time.
 NONE_SHAFT, NONE_BEARING = "none|shaft", "none|bearing"
 TABLE = Path(__file__).resolve().parents[1] / "data" / "diagnosis_calibration.csv"
 
