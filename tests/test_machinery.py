@@ -1,5 +1,6 @@
 """Machine diagnosis: bearing kinematics, severity zones, synthetic faults, CWRU records, bad input."""
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -194,3 +195,21 @@ def test_plot_diagnosis_shows_ses_comb_and_kurtogram(shared_data, tmp_path):
     assert ax_k.images and "kurtogram" in ax_k.get_title()
     ax_e.figure.savefig(tmp_path / "d.png")
     assert (tmp_path / "d.png").stat().st_size > 10_000
+
+
+def test_without_a_unit_shaft_order_faults_are_not_gated_and_the_answer_says_so(tmp_path):
+    # a looseness machine whose samples come without a unit: the ISO level cannot be computed, so the
+    # shaft-order evidence stands alone; the answer and the CLI say that the severity gate was off
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.synth.machine(fault="looseness", snr_db=10, seed=3, duration=6.0)
+    bare = vm.Record.from_array(rec.data[0], fs=rec.fs)
+    d = vm.diagnose(bare, rpm=rec.meta["rpm"])
+    assert d.top == "looseness" and "unit_unknown" in d.flags and d.severity["zone"] is None
+    assert "not weighed against the ISO 10816-3 level" in d.reason
+    known = vm.diagnose(rec)
+    assert known.top == "looseness" and "not weighed" not in known.reason
+    path = tmp_path / "bare.csv"
+    np.savetxt(path, bare.data[0][:, None], header="acc", comments="", delimiter=",")
+    from tests.test_cli import run
+    code, out, _ = run(["diagnose", str(path), "--fs", str(rec.fs), "--rpm", str(rec.meta["rpm"])])
+    assert code == 0 and "severity: not computed, the unit is unknown" in out

@@ -432,6 +432,9 @@ def _main_diagnose(args, out, err) -> int:
         est = diag.speed.get("estimated_rpm")
         print(f"  speed: declared {diag.speed['declared_rpm']:g} rpm, estimated "
               f"{'n/a' if est is None else format(est, '.1f')} rpm {diag.speed['note']}", file=out)
+        if sev.get("velocity_rms_mm_s") is None and "unit_unknown" in diag.flags:
+            print("  severity: not computed, the unit is unknown (give --unit): shaft-order faults are not "
+                  "gated by the ISO level", file=out)
         if sev.get("velocity_rms_mm_s") is not None:
             print(f"  severity: {sev['velocity_rms_mm_s']:.2f} mm/s RMS ({sev['band_hz'][0]:g}-1000 Hz), ISO 10816-3 "
                   f"group {sev['group']} {sev['foundation']}: zone {sev['zone']} {sev['note']}", file=out)

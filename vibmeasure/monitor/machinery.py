@@ -385,6 +385,9 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     top, conf, reason, also, where, (kind, score, parts) = _decide(table, job)
     if "speed_inconsistent" in job.flags:
         reason += "; " + speed["note"]
+    if "unit_unknown" in job.flags and top in SHAFT_FAULTS:
+        reason += ("; the data's unit is unknown, so this shaft-order fault was not weighed against the ISO "
+                   "10816-3 level (give unit=, e.g. 'g')")
     if job.bearing is None:
         job.flags.append("bearing_not_checked")
     extras = {"also": also, "primary": job.primary, "score": score, "confidence_kind": kind}
