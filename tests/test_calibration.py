@@ -34,7 +34,8 @@ def test_isotonic_fit_of_separable_answers_is_a_step_with_the_prior():
 
 
 @pytest.mark.parametrize("score, right, match", [([], [], "non-zero length"), ([0.1, np.nan], [1, 0], "finite"),
-                                                 ([0.1, 0.2], [1], "same")])
+                                                 ([0.1, 0.2], [1], "same"), ([0.1, 0.2], [1, 2], "booleans"),
+                                                 ([0.1, 0.2], [1, np.nan], "booleans")])
 def test_isotonic_fit_bad_input(score, right, match):
     with pytest.raises(vm.ParameterError, match=match):
         fit_isotonic(score, right)
@@ -50,6 +51,9 @@ def test_shipped_maps_are_monotone_probabilities():
     assert calibrated("electrical", 0.9, "shaft") == pytest.approx(np.interp(0.9, *table["shaft"]))
     with pytest.raises(vm.ParameterError, match="no calibration"):
         calibrated("nonsense", 0.5, "nonsense")
+    for bad in (np.nan, -0.1, 1.5):
+        with pytest.raises(vm.ParameterError, match=r"score=.* must be a finite evidence score in \[0, 1\]"):
+            calibrated("none|shaft", bad, "none|shaft")
 
 
 @pytest.mark.parametrize("seed", [90804, 90805, 90806])

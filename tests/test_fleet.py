@@ -73,16 +73,19 @@ def test_store_finds_hashes_on_disk_and_keeps_no_rows_in_memory(tmp_path):
             assert st.has(sha(7)) == "m0000008" and st.has(twin) is None and st.has(sha(300)) is None
             mid = st.add_measurement("a", "p", time=2e9, sha256=sha(7))  # pending: the latest wins
             assert st.has(sha(7)) == mid == "m0000301"
+            st.add_measurement("a", "p", time=2e9 + 1)  # pending without a hash: no hash finds it
+            assert st.has(None) is None and st.has("") is None
     finally:
         tracemalloc.stop()
     # after 200 more committed measurements with results, what stays is the hash index (16 bytes each)
     # and assets/points; holding the rows (about 2 kB each with summaries) would grow by ~400 kB
     assert grown < 200 * 100, grown
     st = vm.Store(p)
-    assert st.has(sha(7)) == "m0000301" and st.has(sha(299)) == "m0000300" and st.n_measurements == 301
+    assert st.has(sha(7)) == "m0000301" and st.has(sha(299)) == "m0000300" and st.n_measurements == 302
     with vm.Store(p, writable=True) as w:  # a reader's view is the file it opened: later commits only append
         w.add_result(w.add_measurement("a", "p", time=3e9), "spectrum", {}, summary={"rms": -1.0})
     assert len(st.results("spectrum")) == 300 and len(vm.Store(p).results("spectrum")) == 301
+    assert st.n_measurements == 302 and vm.Store(p).n_measurements == 303
     with pytest.raises(vm.ParameterError, match="is not in store"):
         st.record("m0000999")
 

@@ -283,11 +283,11 @@ class Store:
 
     def has(self, sha256: str) -> str | None:
         """The measurement id already stored for this content hash, or None (the latest if several)."""
+        if not isinstance(sha256, str) or not sha256:
+            return None   # no hash matches nothing (not a pending measurement stored without a hash)
         for mid in reversed(self._pending_meas):
             if self._pending_meas[mid].get("sha256") == sha256:
                 return mid
-        if not isinstance(sha256, str) or not sha256:
-            return None
         key = _hash_key(sha256)
         i = int(np.searchsorted(self._hash_keys, key, side="right"))
         if not i or self._hash_keys[i - 1] != key:

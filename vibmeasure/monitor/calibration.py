@@ -29,9 +29,8 @@ import numpy as np
 
 from ..core.errors import ParameterError, VibMeasureError
 
-__all__ = ["calibrated", "fit_isotonic", "GROUPS", "UNCHECKED", "NONE_SHAFT", "NONE_BEARING"]
+__all__ = ["calibrated", "fit_isotonic", "UNCHECKED", "NONE_SHAFT", "NONE_BEARING"]
 
-GROUPS = ("shaft", "bearing")
 UNCHECKED = "bearing not checked:"   # prefix of the maps learnt without a bearing (bearing faults unseen)
 # "none" with a bearing: its score's two parts (shaft-order, bearing) are mapped on their own, each to the
 # chance that no fault of its kind hides behind the answer, and the two multiplied. One map of their
@@ -57,6 +56,8 @@ def fit_isotonic(score, right, *, prior: float = 1.0):
         raise ParameterError(f"score and right must be 1-D of the same non-zero length, got {s.shape} and {y.shape}")
     if not np.isfinite(s).all():
         raise ParameterError("score must be finite")
+    if not np.isin(y, (0.0, 1.0)).all():
+        raise ParameterError("right must hold booleans (or 0/1): whether each answer was right")
     if prior < 0:
         raise ParameterError(f"prior={prior!r} must be >= 0")
     order = np.argsort(s, kind="stable")
@@ -114,6 +115,8 @@ def calibrated(answer: str, score: float, group: str) -> float:
     """Probability that ``answer`` ("none" or a fault name) given with this raw score is right, from
     the shipped calibration table; an answer it has no map for uses its ``group``'s ("shaft",
     "bearing")."""
+    if not 0.0 <= float(score) <= 1.0:   # also rejects NaN
+        raise ParameterError(f"score={score!r} must be a finite evidence score in [0, 1]")
     table = _table()
     if answer not in table and group not in table:
         raise ParameterError(f"no calibration for answer={answer!r} nor its group={group!r} in {TABLE.name}")
