@@ -189,3 +189,26 @@ def test_cwru_drive_end_fault_records_with_every_channel(shared_data):
     orr = vm.diagnose(vm.read(shared_data("cwru/OR007_6_0.mat"), fs=12000, unit="g"), bearing="6205-2RS")
     assert orr.top == "bearing_outer_race"
     assert orr.faults.set_index("fault").loc["bearing_outer_race"].found_hz == pytest.approx(107.6, abs=0.8)
+
+
+def test_a_record_resampled_to_48_khz_keeps_its_answer(shared_data, monkeypatch):
+    # OR007@3_1 (fan-end outer race) resampled 12 -> 48 kHz: above 6 kHz only the resampling filter's
+    # stop band is left. The envelope bands stop at the measured band's top (6.6-7.1 kHz) and the
+    # answer is the one at 12 kHz; with bands up to Nyquist, whitening lifts the stop band's images to
+    # full height and the same record came out as an inner-race fault (measured when written)
+    from scipy.signal import resample_poly
+    rec = vm.read(shared_data("cwru_fe/OR007@3_1.mat"), fs=12000, unit="g")
+    up = vm.Record.from_array(resample_poly(rec.data, 4, 1, axis=1, window=("kaiser", 10.0)), fs=48000.0,
+                              names=list(rec.names), unit="g")
+    kw = dict(bearing="6203-2RS", channel="X299_FE_time", rpm=rec.meta["rpm"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        d12, d48 = vm.diagnose(rec, **kw), vm.diagnose(up, **kw)
+        assert d12.top == d48.top == "bearing_outer_race"
+        assert all(6000.0 < f < 7500.0 for f in d48.extras["measured_top_hz"].values())
+        assert set(d12.extras["measured_top_hz"].values()) == {6000.0}   # content up to Nyquist
+        assert d48.to_dict()["measured_top_hz"] == d48.extras["measured_top_hz"]
+        band = d48.faults.set_index("fault").loc["bearing_outer_race"].band_hz
+        assert band[1] <= 7500.0
+        monkeypatch.setattr(bf, "_measured_top", lambda X, fs, n: fs / 2)
+        assert vm.diagnose(up, **kw).top == "bearing_inner_race"

@@ -73,7 +73,8 @@ class Diagnosis:
                           "channel": self.channel, "bearing_checked": self.bearing_checked,
                           "faults": self.faults.to_dict(orient="records"), "speed": self.speed,
                           "severity": self.severity, "envelope_band_hz": list(self.envelope_band_hz),
-                          "flags": list(self.flags), "also": list(self.extras.get("also", ()))})
+                          "flags": list(self.flags), "also": list(self.extras.get("also", ())),
+                          "measured_top_hz": self.extras.get("measured_top_hz")})
 
     def __repr__(self) -> str:
         return f"Diagnosis(top={self.top!r}, confidence={self.confidence:.2f}: {self.reason})"
@@ -396,6 +397,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     env_band = ()
     if ev is not None:
         extras.update(_plot_material(ev, top))
+        extras["measured_top_hz"] = dict(ev["measured_top_hz"])
         env_band = extras["ses"]["band_hz"]
     return Diagnosis(top, conf, reason, table, speed, severity, tuple(env_band), tuple(job.flags), extras,
                      channel=str(where), bearing_checked=job.bearing is not None)

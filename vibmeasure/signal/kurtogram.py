@@ -74,9 +74,10 @@ def _kurt(c: np.ndarray) -> float:
 
 
 def _spectrum_map(X: np.ndarray, n: int, fs: float, *, min_bandwidth: float, max_level: float, k_cyc: int,
-                  f_lo: float = 0.0):
-    """Kurtosis and negentropy of every band of the tree whose width is at least min_bandwidth and
-    whose lower edge is at f_lo or above (NaN for the others)."""
+                  f_lo: float = 0.0, f_hi: float | None = None):
+    """Kurtosis and negentropy of every band of the tree whose width is at least min_bandwidth, whose
+    lower edge is at f_lo or above and of which at least 3/4 lies below f_hi (NaN for the others)."""
+    k_hi = np.inf if f_hi is None else f_hi * n / fs
     n_bins = X.size - 1
     levels, nbs, kur, neg = [], [], [], []
     for lev, nb in _tree(max_level):
@@ -85,7 +86,7 @@ def _spectrum_map(X: np.ndarray, n: int, fs: float, *, min_bandwidth: float, max
         kv, nv = np.full(nb, np.nan), np.full(nb, np.nan)
         for i in range(nb):
             k0, k1 = _band_bins(n_bins, nb, i)
-            if k0 * fs / n < f_lo - 1e-9 or k1 - k0 < 8:
+            if k0 * fs / n < f_lo - 1e-9 or k1 - k0 < 8 or min(k1, k_hi) - k0 < 0.75 * (k1 - k0):
                 continue
             c = _complex_envelope(X, max(k0, 1), k1, n)
             kv[i] = _kurt(c)
@@ -96,7 +97,7 @@ def _spectrum_map(X: np.ndarray, n: int, fs: float, *, min_bandwidth: float, max
 
 def _kurtogram_of(x: np.ndarray | None, fs: float, *, min_bandwidth: float, max_level: float | None,
                   criterion: str, cyclic_max: float | None, X: np.ndarray | None = None,
-                  f_lo: float = 0.0, n: int | None = None) -> Kurtogram:
+                  f_lo: float = 0.0, n: int | None = None, f_hi: float | None = None) -> Kurtogram:
     """The map of one signal x, or of its rfft X (record length n)."""
     n = x.size if n is None else n
     if X is None:
@@ -105,9 +106,10 @@ def _kurtogram_of(x: np.ndarray | None, fs: float, *, min_bandwidth: float, max_
         max_level = max(0.0, np.log2(fs / 2 / min_bandwidth))
     k_cyc = int(round((cyclic_max if cyclic_max else min_bandwidth) * n / fs))
     levels, nbs, kur, neg = _spectrum_map(X, n, fs, min_bandwidth=min_bandwidth, max_level=max_level, k_cyc=k_cyc,
-                                          f_lo=f_lo)
+                                          f_lo=f_lo, f_hi=f_hi)
     kg = Kurtogram(fs, levels, nbs, kur, neg, (), criterion, np.nan, min_bandwidth,
-                   {"max_level": max_level, "cyclic_max_hz": cyclic_max, "min_frequency_hz": f_lo})
+                   {"max_level": max_level, "cyclic_max_hz": cyclic_max, "min_frequency_hz": f_lo,
+                    "max_frequency_hz": fs / 2 if f_hi is None else f_hi})
     lo, hi, _, val = kg.best(criterion)
     return Kurtogram(fs, levels, nbs, kur, neg, (lo, hi), criterion, val, min_bandwidth, kg.params)
 

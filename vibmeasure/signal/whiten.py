@@ -31,6 +31,41 @@ def _cepstral(x: np.ndarray) -> np.ndarray:
     return _fft.irfft(X / np.maximum(mag, floor), n=x.size)
 
 
+DEAD_DB = 25.0   # a top band this far below the typical level under it holds no measurement
+
+
+def _measured_top(X: np.ndarray, fs: float, n: int) -> float:
+    """Upper edge (Hz) of the band a record measures, from its rfft X (record length n).
+
+    The spectrum is cut into 512 equal bands (each level the median of 5 neighbours, so a lone tone
+    does not count); the measured band ends where every band above stays more than DEAD_DB below the
+    mean level (dB) of the bands under it: the stop band of an anti-alias or resampling filter, or the
+    converter's floor. Whitening would lift that band to full height, and with it filter images and
+    converter artefacts. A record with content up to Nyquist keeps its whole band."""
+    P = np.abs(X[1:]) ** 2
+    nb = min(512, P.size // 8)
+    if nb < 64:
+        return fs / 2
+    from scipy.ndimage import median_filter
+    edges = np.linspace(0, P.size, nb + 1).astype(int)
+    level = np.add.reduceat(P, edges[:-1]) / np.diff(edges)
+    L = median_filter(10 * np.log10(np.maximum(level, 1e-300)), size=5, mode="nearest")
+    top_max = np.maximum.accumulate(L[::-1])[::-1]          # loudest band from j up
+    j0 = nb // 32
+    below = (np.cumsum(L)[j0 - 1:-1] / np.arange(j0, nb))   # mean level (dB) of the bands under j
+    dead = np.flatnonzero(top_max[j0:] < below - DEAD_DB)
+    return fs / 2 if not dead.size else float(edges[j0 + dead[0]]) * fs / n
+
+
+def _cepstral_spectrum(X: np.ndarray, k_top: int | None = None) -> np.ndarray:
+    """The spectrum of the cepstrally whitened signal (X over its magnitude), zero above bin k_top."""
+    mag = np.abs(X)
+    Xw = X / np.maximum(mag, 1e-12 * max(float(mag.max()), 1e-300))
+    if k_top is not None:
+        Xw[k_top + 1:] = 0
+    return Xw
+
+
 def _edit_lines(x: np.ndarray, *, width: int = 33, ratio: float = 3.0) -> np.ndarray:
     """Discrete lines cut to the local level of the spectrum (a frequency-domain discrete/random
     separation): every bin whose magnitude exceeds ``ratio`` x the running median of ``width`` bins
