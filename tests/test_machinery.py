@@ -213,3 +213,40 @@ def test_without_a_unit_shaft_order_faults_are_not_gated_and_the_answer_says_so(
     from tests.test_cli import run
     code, out, _ = run(["diagnose", str(path), "--fs", str(rec.fs), "--rpm", str(rec.meta["rpm"])])
     assert code == 0 and "severity: not computed, the unit is unknown" in out
+
+
+def test_the_cli_names_a_band_left_out_above_a_filter_edge(tmp_path):
+    # an outer-race machine recorded at 12 kHz, resampled to 48 kHz and stored as HDF5: the CLI says
+    # that the channel measures up to about 6.6 kHz and still finds the outer race
+    from scipy.signal import resample_poly
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.synth.machine(fault="bearing_outer_race", snr_db=0, seed=2, duration=4.0)
+    up = vm.Record.from_array(resample_poly(rec.data[0], 4, 1, window=("kaiser", 10.0)), fs=4 * rec.fs,
+                              names=["acc"], unit="g")
+    path = vm.write(tmp_path / "up.h5", up)
+    from tests.test_cli import run
+    code, out, _ = run(["diagnose", str(path), "--rpm", str(rec.meta["rpm"]), "--bearing", "6205-2RS"])
+    assert code == 0 and out.splitlines()[0].endswith("BEARING_OUTER_RACE (confidence 1.00) in acc")
+    line = next(ln for ln in out.splitlines() if "measured band:" in ln)
+    top = float(line.split("up to ")[1].split(" Hz")[0])
+    assert 6000 < top < 7500 and "Nyquist 24000 Hz" in line
+    code, out, _ = run(["diagnose", str(path), "--rpm", str(rec.meta["rpm"]), "--bearing", "6205-2RS", "--json"])
+    assert 6000 < json.loads(out)["measured_top_hz"]["acc"] < 7500
+
+
+def test_a_record_filtered_below_the_demodulation_region_is_flagged():
+    # an inner-race machine low-passed at 720 Hz (8th-order Butterworth, forwards and backwards) over a
+    # converter floor: the measured band ends near 0.9 kHz, below 10 x BPFI + two narrowest bands, so
+    # the answer carries the flag band_limited and says where the channel's band ends
+    from scipy.signal import butter, sosfiltfilt
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.synth.machine(fault="bearing_inner_race", snr_db=10, seed=2, duration=6.0)
+    y = sosfiltfilt(butter(8, 720.0, fs=rec.fs, output="sos"), rec.data[0])
+    y = y + np.random.default_rng(0).normal(size=y.size) * 1e-5 * y.std()
+    d = vm.diagnose(vm.Record.from_array(y, fs=rec.fs, unit="g", names=["acc"]), rpm=rec.meta["rpm"],
+                    bearing="6205-2RS")
+    top = d.extras["measured_top_hz"]["acc"]
+    assert 720.0 < top < 1200.0 and "band_limited" in d.flags
+    assert f"acc measures only up to {top:.0f} Hz" in d.reason
+    full = vm.diagnose(rec, bearing="6205-2RS")
+    assert "band_limited" not in full.flags and full.extras["measured_top_hz"] == {full.channel: rec.fs / 2}

@@ -438,6 +438,12 @@ def _main_diagnose(args, out, err) -> int:
         if sev.get("velocity_rms_mm_s") is not None:
             print(f"  severity: {sev['velocity_rms_mm_s']:.2f} mm/s RMS ({sev['band_hz'][0]:g}-1000 Hz), ISO 10816-3 "
                   f"group {sev['group']} {sev['foundation']}: zone {sev['zone']} {sev['note']}", file=out)
+        tops = diag.extras.get("measured_top_hz") or {}
+        cut = {k: v for k, v in tops.items() if v < 0.99 * rec.fs / 2}
+        if cut:
+            print("  measured band: " + ", ".join(f"{k} up to {v:.0f} Hz" for k, v in cut.items())
+                  + f" (Nyquist {rec.fs / 2:g} Hz; above: a filter's stop band, left out of the envelope bands)",
+                  file=out)
         for _, r in diag.faults.iterrows():
             p = r.get("p_value")
             extra = f"  p = {p:.2g} ({r.channel}, {r.preprocessing})" if p is not None and p == p and p < 1 else ""

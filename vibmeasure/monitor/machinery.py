@@ -379,6 +379,9 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         rows.append(sf.electrical_row(f, A, f1, line_frequency, level, _line, _row, LINE_DB))
     b_rows, ev = _bearing_rows(job, f1, speed)
     rows += b_rows
+    narrow = _narrow_channels(ev, job, f1) if ev is not None and job.band is None else []
+    if narrow:
+        job.flags.append("band_limited")
     if job.gear is not None:
         rows.append(sf.gear_row(f, A, f1, job.gear, _line, _row, LINE_DB))
     import pandas as pd
@@ -389,6 +392,9 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     if "unit_unknown" in job.flags and top in SHAFT_FAULTS:
         reason += ("; the data's unit is unknown, so this shaft-order fault was not weighed against the ISO "
                    "10816-3 level (give unit=, e.g. 'g')")
+    if narrow:
+        reason += ("; " + ", ".join(f"{k} measures only up to {v:.0f} Hz" for k, v in narrow)
+                   + " (above: a filter's stop band): the envelope bands reach down among the shaft harmonics")
     if job.bearing is None:
         job.flags.append("bearing_not_checked")
     extras = {"also": also, "primary": job.primary, "score": score, "confidence_kind": kind}
@@ -401,6 +407,19 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         env_band = extras["ses"]["band_hz"]
     return Diagnosis(top, conf, reason, table, speed, severity, tuple(env_band), tuple(job.flags), extras,
                      channel=str(where), bearing_checked=job.bearing is not None)
+
+
+def _narrow_channels(ev, job: _Job, f1: float) -> list:
+    """Channels whose measured band (below a filter's edge) cannot hold a demodulation band of the
+    narrowest width above the shaft-harmonic region: [(channel, top of its band in Hz)]."""
+    from .bearing_faults import _limits
+    freqs = job.bearing.frequencies(f1)
+    out = []
+    for name, top in ev["measured_top_hz"].items():
+        _, min_bw, _, f_lo = _limits(job.fs, f1, freqs, top)
+        if f_lo < min(max(10.0 * freqs["BPFI"], 500.0), 0.5 * job.fs - 2 * min_bw) - 1e-9:
+            out.append((name, top))
+    return out
 
 
 def _plot_material(ev, top):

@@ -39,7 +39,7 @@ def _measured_top(X: np.ndarray, fs: float, n: int) -> float:
 
     The spectrum is cut into 512 equal bands (each level the median of 5 neighbours, so a lone tone
     does not count); the measured band ends where every band above stays more than DEAD_DB below the
-    mean level (dB) of the bands under it: the stop band of an anti-alias or resampling filter, or the
+    median level of the bands under it: the stop band of an anti-alias or resampling filter, or the
     converter's floor. Whitening would lift that band to full height, and with it filter images and
     converter artefacts. A record with content up to Nyquist keeps its whole band."""
     P = np.abs(X[1:]) ** 2
@@ -51,10 +51,12 @@ def _measured_top(X: np.ndarray, fs: float, n: int) -> float:
     level = np.add.reduceat(P, edges[:-1]) / np.diff(edges)
     L = median_filter(10 * np.log10(np.maximum(level, 1e-300)), size=5, mode="nearest")
     top_max = np.maximum.accumulate(L[::-1])[::-1]          # loudest band from j up
-    j0 = nb // 32
-    below = (np.cumsum(L)[j0 - 1:-1] / np.arange(j0, nb))   # mean level (dB) of the bands under j
-    dead = np.flatnonzero(top_max[j0:] < below - DEAD_DB)
-    return fs / 2 if not dead.size else float(edges[j0 + dead[0]]) * fs / n
+    # the typical level under j: the median of the bands below (the pass band, as long as it is the
+    # larger part), on every 4th band
+    js = np.arange(nb // 32, nb, 4)
+    below = np.array([np.median(L[:j]) for j in js])
+    dead = np.flatnonzero(top_max[js] < below - DEAD_DB)
+    return fs / 2 if not dead.size else float(edges[js[dead[0]]]) * fs / n
 
 
 def _cepstral_spectrum(X: np.ndarray, k_top: int | None = None) -> np.ndarray:
