@@ -250,3 +250,14 @@ def test_a_record_filtered_below_the_demodulation_region_is_flagged():
     assert f"acc measures only up to {top:.0f} Hz" in d.reason
     full = vm.diagnose(rec, bearing="6205-2RS")
     assert "band_limited" not in full.flags and full.extras["measured_top_hz"] == {full.channel: rec.fs / 2}
+    # an outer-race machine low-passed at 300 Hz: no comb is left, and a "none" from a channel with no
+    # band to demodulate is mapped as if the bearing had not been checked (below 0.5, where a "none"
+    # with a full band reads about 1)
+    orr = vm.synth.machine(fault="bearing_outer_race", snr_db=10, seed=2, duration=6.0)
+    y = sosfiltfilt(butter(8, 300.0, fs=orr.fs, output="sos"), orr.data[0])
+    y = y + np.random.default_rng(0).normal(size=y.size) * 1e-6 * y.std()
+    d = vm.diagnose(vm.Record.from_array(y, fs=orr.fs, unit="g", names=["acc"]), rpm=orr.meta["rpm"],
+                    bearing="6205-2RS")
+    assert d.top == "none" and "band_limited" in d.flags and d.confidence < 0.5
+    healthy = vm.diagnose(vm.synth.machine(fault="none", snr_db=10, seed=2, duration=6.0), bearing="6205-2RS")
+    assert healthy.top == "none" and healthy.confidence > 0.9

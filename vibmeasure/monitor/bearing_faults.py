@@ -313,7 +313,7 @@ def _candidates(x, fs, f1, freqs, band, whitening):
     k_hi = int(np.floor(f_hi * x.size / fs))
     f_top, min_bw, f_need, f_lo = _limits(fs, f1, freqs, f_hi)
     if band is not None:
-        return [("cepstral", tuple(band), _cepstral_spectrum(X), None), ("raw", tuple(band), X, None)], fs / 2
+        return [("cepstral", tuple(band), _cepstral_spectrum(X), None), ("raw", tuple(band), X, None)], f_hi
     Xw = _cepstral_spectrum(X, k_hi)
     out = []
     if "cepstral" in whitening:

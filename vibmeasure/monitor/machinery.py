@@ -96,6 +96,7 @@ class _Job:
     band: tuple | None
     flags: list
     prewhitening: tuple = ("cepstral",)
+    bearing_weak: bool = False   # every channel's measured band ends below the demodulation region
 
 
 def _line(freq, values, f, tol, floor_halfwidth):
@@ -325,9 +326,10 @@ def _decide(table, job: _Job):
     top_score = (f"strongest candidate {cand.fault} at score {cand.confidence:.2f}" if cand.confidence > 0
                  else "every family scored 0")
     reason = f"none: {why}; {top_score}{strongest}{checked}"
-    if job.bearing is not None:  # each part mapped to the chance that no fault of its kind was missed
+    if job.bearing is not None and not job.bearing_weak:
+        # each part mapped to the chance that no fault of its kind was missed
         conf = calibrated(NONE_SHAFT, s_shaft, NONE_SHAFT) * calibrated(NONE_BEARING, s_bear, NONE_BEARING)
-    else:
+    else:   # no bearing, or no channel with a band to demodulate: the bearing side says little
         conf = calibrated(UNCHECKED + "none", p_none, UNCHECKED + "none")
     return "none", conf, reason, [], job.primary, ("none", p_none, {"shaft": s_shaft, "bearing": s_bear})
 
@@ -382,6 +384,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     narrow = _narrow_channels(ev, job, f1) if ev is not None and job.band is None else []
     if narrow:
         job.flags.append("band_limited")
+        job.bearing_weak = len(narrow) == len(ev["measured_top_hz"])
     if job.gear is not None:
         rows.append(sf.gear_row(f, A, f1, job.gear, _line, _row, LINE_DB))
     import pandas as pd

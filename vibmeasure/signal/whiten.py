@@ -53,7 +53,7 @@ def _measured_top(X: np.ndarray, fs: float, n: int) -> float:
     top_max = np.maximum.accumulate(L[::-1])[::-1]          # loudest band from j up
     # the typical level under j: the median of the bands below (the pass band, as long as it is the
     # larger part), on every 4th band
-    js = np.arange(nb // 32, nb, 4)
+    js = np.arange(8, nb, 4)
     below = np.array([np.median(L[:j]) for j in js])
     dead = np.flatnonzero(top_max[js] < below - DEAD_DB)
     return fs / 2 if not dead.size else float(edges[js[dead[0]]]) * fs / n
