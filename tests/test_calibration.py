@@ -81,16 +81,16 @@ def test_without_a_bearing_a_none_is_weak_evidence_of_health():
     # in nine, three with bearing faults) a "none" given then was right in 450 of 1893 answers; the same
     # healthy machine with its bearing named is a confident "none"
     warnings.simplefilter("ignore", vm.QualityWarning)
-    rec = vm.synth.machine(fault="none", snr_db=0, seed=100900, duration=6.0)
+    rec = vm.synth.machine(fault="none", snr_db=0, seed=101060, duration=6.0)
     blind, seen = vm.diagnose(rec, gear=32), vm.diagnose(rec, bearing="6205-2RS", gear=32)
     assert blind.top == seen.top == "none"
     assert 0.1 < blind.confidence < 0.4 and seen.confidence > 0.95
     assert "bearing faults not checked" in blind.reason
-    # this machine shows a marginal BPFO comb (p ~ 0.002, not called): the bearing part of its "none"
-    # score is 0.75, as low as a buried resonance's whole score, yet a "none" with its shaft-order part
+    # this machine shows a marginal BPFO comb (p ~ 0.001, not called): the bearing part of its "none"
+    # score is 0.64, as low as a buried resonance's whole score, yet a "none" with its shaft-order part
     # near 1 was right in every calibration machine: calibrated apart, the parts keep it confident
     parts = seen.extras["score_parts"]
-    assert parts["shaft"] > 0.95 and parts["bearing"] < 0.8
+    assert parts["shaft"] > 0.95 and parts["bearing"] < 0.7
 
 
 def test_report_flags_an_unlikely_none_for_a_look():

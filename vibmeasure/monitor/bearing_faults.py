@@ -287,6 +287,13 @@ def _explain(ses: _SES, freqs: dict, f1: float, shaft_hz: float, f1_known: bool,
 # --- spectra to test ------------------------------------------------------------------------------
 
 WHITENING = ("cepstral", "ar")
+# Share of the record tapered (Tukey window, half at each end) before the spectrum that is whitened. A
+# record's ends do not meet: the jump leaks across the whole spectrum (1/f), and so does an off-bin
+# tone. Whitening lifts that leakage to full height where the signal is weak (above a low-pass edge,
+# around a strong tone), and it becomes an impulse at the record's ends with high kurtosis. On the
+# development records (scratch checks), a tone 20 dB above the RMS at 0.4 fs turned 3 "none" into
+# wrong calls, and low-passing at 0.4 fs gave 5 wrong calls; with the taper, none and 0.
+TAPER = 0.05
 
 
 def _limits(fs, f1, freqs, f_top_band=None):
@@ -308,7 +315,8 @@ def _candidates(x, fs, f1, freqs, band, whitening):
     infogram's; ar: shaft-synchronous part and remaining discrete lines removed, AR-whitened,
     kurtogram band; with a user band: that band, cepstral-whitened and raw. Above the measured band
     (``_measured_top``: a filter's stop band, the converter's floor) the whitened spectra are zero."""
-    X = _fft.rfft(x - x.mean())
+    from scipy.signal.windows import tukey
+    X = _fft.rfft((x - x.mean()) * tukey(x.size, TAPER))
     f_hi = _measured_top(X, fs, x.size)
     k_hi = int(np.floor(f_hi * x.size / fs))
     f_top, min_bw, f_need, f_lo = _limits(fs, f1, freqs, f_hi)
