@@ -167,3 +167,26 @@ def test_every_plot_shares_the_one_style():
         ax = fig.axes[0]
         assert ax.xaxis.label.get_fontsize() == STYLE["axes.labelsize"]
     plt.close("all")
+
+
+def test_the_kurtogram_marks_where_the_measured_band_ends():
+    # an outer-race machine resampled 12.8 -> 51.2 kHz: the kurtogram panel draws a dashed line at the
+    # measured band's edge (about 7 kHz, where the resampling filter has cut 25 dB) and says so; the
+    # record as sampled has content to Nyquist and no such line
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from scipy.signal import resample_poly
+    from vibmeasure import plot as P
+    rec = vm.synth.machine(fault="bearing_outer_race", rpm=1500.0, fs=12800.0, duration=2.0, seed=1)
+    up = vm.Record.from_array(resample_poly(rec.data[0], 4, 1, window=("kaiser", 10.0)), fs=51200.0,
+                              names=["acc"], unit="g")
+    for r, edged in ((rec, False), (up, True)):
+        d = vm.diagnose(r, rpm=1500.0, bearing="6205-2RS")
+        ax_k = P.plot_diagnosis(r, d)[3]
+        top = d.extras["measured_top_hz"]["acc"]
+        dashed = [ln for ln in ax_k.get_lines() if ln.get_linestyle() == "--"]
+        assert ("measured band ends at" in ax_k.get_title()) == edged and len(dashed) == int(edged)
+        if edged:
+            assert 6400.0 < top < 8000.0 and dashed[0].get_xdata()[0] == pytest.approx(top)
+    plt.close("all")

@@ -454,8 +454,13 @@ def _plot_kurtogram(ax, kg, band):
     if band is not None:
         ax.axvspan(band[0], band[1], fill=False, ec="w", lw=1.2)
     lo, hi, lev, val = kg.best("kurtosis")
+    top = kg.params.get("max_frequency_hz")
+    edge = ""
+    if top is not None and top < 0.99 * kg.fs / 2:   # above it a filter's stop band: left out
+        ax.axvline(top, color="0.3", ls="--", lw=1.0)
+        edge = f"; dashed: the measured band ends at {top:.0f} Hz"
     ax.set_title(f"fast kurtogram (cepstral-whitened): max kurtosis {val:.2f} in {lo:.0f}-{hi:.0f} Hz "
-                 f"(level {lev:g}); outlined: band of the evidence", fontsize=8)
+                 f"(level {lev:g}); outlined: band of the evidence{edge}", fontsize=8)
 
 
 @_styled
