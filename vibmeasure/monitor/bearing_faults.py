@@ -9,8 +9,9 @@ Pipeline for one record (``bearing_evidence``):
    development recordings the AR branch added false calls (lines of other machine parts survive it),
    so the default is cepstral only. Bands stop at the top of the band the channel measures
    (``whiten._measured_top``): above an anti-alias or resampling filter's edge whitening would lift
-   the stop band, its images and the converter's floor to full height (a CWRU record resampled from
-   12 to 48 kHz gave 8 wrong calls of 53 before, 1 after, the same as at 12 kHz).
+   the stop band, its images and the converter's floor to full height (the 53 development records
+   resampled from 12 to 48 kHz gave 8 wrong calls before, 1 after, the same as at 12 kHz). Each
+   record is tapered first (``TAPER``).
 2. normalise: each SES power line divided by its local floor (running median / ln 2). For Gaussian
    noise the ratio ``r`` is exponential with mean 1 (chi-square with 2 degrees of freedom over 2).
 3. explain: lines at exact shaft harmonics, then the cage comb (FTF harmonics that are not BPFO's),
@@ -291,8 +292,9 @@ WHITENING = ("cepstral", "ar")
 # record's ends do not meet: the jump leaks across the whole spectrum (1/f), and so does an off-bin
 # tone. Whitening lifts that leakage to full height where the signal is weak (above a low-pass edge,
 # around a strong tone), and it becomes an impulse at the record's ends with high kurtosis. On the
-# development records (scratch checks), a tone 20 dB above the RMS at 0.4 fs turned 3 "none" into
-# wrong calls, and low-passing at 0.4 fs gave 5 wrong calls; with the taper, none and 0.
+# development records, with the measured band's edge already in place, a tone 20 dB above the RMS
+# at 0.4 fs turned 3 "none" into wrong calls and low-passing at 0.4 fs gave 5 wrong calls; with the
+# taper, none and 0 (benchmarks/diagnosis_robustness.py).
 TAPER = 0.05
 
 
