@@ -259,5 +259,9 @@ def test_a_record_filtered_below_the_demodulation_region_is_flagged():
     d = vm.diagnose(vm.Record.from_array(y, fs=orr.fs, unit="g", names=["acc"]), rpm=orr.meta["rpm"],
                     bearing="6205-2RS")
     assert d.top == "none" and "band_limited" in d.flags and d.confidence < 0.5
+    from vibmeasure.reporting import diagnosis_section
+    sec = diagnosis_section(vm.Record.from_array(y, fs=orr.fs, unit="g", names=["acc"]), d, "low-passed")
+    assert sec["verdict_class"] == "watch" and [f["flag"] for f in sec["flags"]] == ["band_limited"]
+    assert "sample faster" in sec["flags"][0]["advice"] and "filter's edge" in sec["flags"][0]["text"]
     healthy = vm.diagnose(vm.synth.machine(fault="none", snr_db=10, seed=2, duration=6.0), bearing="6205-2RS")
     assert healthy.top == "none" and healthy.confidence > 0.9

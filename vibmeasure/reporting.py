@@ -42,6 +42,8 @@ FLAG_ADVICE = {
     "double_hit": "repeat the hit: a double hit corrupts the force spectrum",
     "not_impact": "use estimate_frf for shaker (continuous) excitation",
     "bearing_not_checked": "give the bearing (catalogue name or geometry) so bearing faults are searched",
+    "band_limited": "record a wider band (sample faster, open the anti-alias filter): bearing impacts ring in "
+                    "resonances well above the shaft harmonics",
 }
 
 

@@ -29,6 +29,10 @@ FLAG_TEXT = {
     "colored_noise": "the noise near this mode is stronger than the broadband level: std scaled up",
     "low_snr": "the mode is weak compared with the noise",
     "start_detected": "the decay starts after the beginning of the record (trigger/impact found)",
+    # machine diagnosis
+    "bearing_not_checked": "no bearing given: bearing faults were not searched",
+    "band_limited": "a channel measures only up to a filter's edge, too low to demodulate above the shaft "
+                    "harmonics: the bearing evidence is weak",
 }
 
 
