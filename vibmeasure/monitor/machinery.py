@@ -417,12 +417,9 @@ def _narrow_channels(ev, job: _Job, f1: float) -> list:
     narrowest width above the shaft-harmonic region: [(channel, top of its band in Hz)]."""
     from .bearing_faults import _limits
     freqs = job.bearing.frequencies(f1)
-    out = []
-    for name, top in ev["measured_top_hz"].items():
-        _, min_bw, _, f_lo = _limits(job.fs, f1, freqs, top)
-        if f_lo < min(max(10.0 * freqs["BPFI"], 500.0), 0.5 * job.fs - 2 * min_bw) - 1e-9:
-            out.append((name, top))
-    return out
+    f_lo_full = _limits(job.fs, f1, freqs)[3]
+    return [(name, top) for name, top in ev["measured_top_hz"].items()
+            if _limits(job.fs, f1, freqs, top)[3] < f_lo_full - 1e-9]
 
 
 def _plot_material(ev, top):

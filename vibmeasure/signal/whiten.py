@@ -25,10 +25,7 @@ def _cepstral(x: np.ndarray) -> np.ndarray:
     """Cepstral pre-whitening: the spectrum divided by its magnitude (the real cepstrum set to zero
     except at quefrency 0), so every line and resonance gets the same height and only the phase,
     which carries the impacts' timing, is left."""
-    X = _fft.rfft(x - x.mean())
-    mag = np.abs(X)
-    floor = 1e-12 * max(float(mag.max()), 1e-300)
-    return _fft.irfft(X / np.maximum(mag, floor), n=x.size)
+    return _fft.irfft(_cepstral_spectrum(_fft.rfft(x - x.mean())), n=x.size)
 
 
 DEAD_DB = 25.0   # a top band this far below the typical level under it holds no measurement
