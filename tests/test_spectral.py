@@ -62,6 +62,44 @@ def test_psd_equals_scipy_welch(rng, kw):
     np.testing.assert_allclose(ours.values, ref, rtol=1e-10)
 
 
+@pytest.mark.parametrize("nperseg,noverlap", [(4096, 2048), (4096, 3072), (4096, 0), (1000, 250), (777, 300)])
+def test_psd_removes_large_offsets_like_welch(rng, monkeypatch, nperseg, noverlap):
+    # Offsets far above the noise, in several read blocks (READ_SAMPLES made small) and both ways of
+    # summing segments (parts of gcd(step, nperseg) samples; plain sums for 777/300). The mean is
+    # taken out of the lines the window's transform touches after the FFT, from values ~offset x N:
+    # cancellation leaves ~1e-12 of the line (welch subtracts before windowing): 1e-9
+    import vibmeasure.signal.spectral as sp
+    monkeypatch.setattr(sp, "READ_SAMPLES", 30_000)
+    x = rng.normal(size=(2, 100_003)) + np.array([[40.0], [-2.0e3]])
+    ours = vm.psd(vm.Record(x, fs=FS), nperseg=nperseg, noverlap=noverlap)
+    _, ref = sg.welch(x, fs=FS, nperseg=nperseg, noverlap=noverlap)
+    np.testing.assert_allclose(ours.values, ref, rtol=1e-9)
+    # left in, the -2000 offset would put lines 0-1 some 1e9 times above the noise level
+    assert ours.values[1, :2].max() < 10 * ours.values[1, 5:].mean()
+
+
+def test_psd_from_several_threads_at_once(rng):
+    # each thread keeps its own work buffers between calls: concurrent calls must not share them
+    from concurrent.futures import ThreadPoolExecutor
+    recs = [vm.Record(rng.normal(size=2 ** 17) + k, fs=FS) for k in range(6)]
+    alone = [vm.psd(r, nperseg=2048).values for r in recs]
+    with ThreadPoolExecutor(3) as ex:
+        for _ in range(3):
+            together = list(ex.map(lambda r: vm.psd(r, nperseg=2048).values, recs))
+            for a, b in zip(alone, together):
+                # the two FFT threads share a call's batches differently from run to run, so the
+                # sums add in another order: rounding only (1e-13); a shared buffer would be O(1)
+                np.testing.assert_allclose(b, a, rtol=1e-13)
+
+
+def test_work_buffers_kept_only_when_small():
+    import vibmeasure.signal.spectral as sp
+    a = sp._scratch("probe", (16, 4096), np.float64)
+    assert sp._scratch("probe", (16, 4096), np.float64) is a          # reused: no fresh pages per call
+    big = (16, sp.SCRATCH_BYTES // 8)                                    # 16 x 4 MB: allocated per call
+    assert sp._scratch("probe_big", big, np.float64) is not sp._scratch("probe_big", big, np.float64)
+
+
 def test_csd_and_coherence_equal_scipy(rng):
     x = rng.normal(size=20_000)
     y = np.convolve(x, [0.5, 0.3, -0.2], mode="same") + 0.3 * rng.normal(size=x.size)

@@ -12,6 +12,8 @@ is handled like one in memory. Results equal ``scipy.signal.welch``/``csd`` to r
 from __future__ import annotations
 
 import functools
+import math
+import threading
 from typing import Callable
 
 import numpy as np
@@ -174,6 +176,14 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
     W_mean = (W_lines / nperseg).astype(np.complex64 if dtype == np.float32 else complex)  # per unit segment sum
     if sparse and lines.size and np.array_equal(lines, np.arange(lines[0], lines[-1] + 1)):
         lines = slice(int(lines[0]), int(lines[-1]) + 1)   # contiguous lines: a view, not a gather
+    # Summed powers only: the threads keep each segment's raw values at those lines, and the lines are
+    # detrended once at the end from the segment sums (a few operations per block instead of three per
+    # batch: each numpy call that releases the GIL makes the two threads hand it over, and at 2^18
+    # samples those hand-overs cost more than the arithmetic)
+    deferred = sparse and reducer == "sum" and not keep_segments and not pairs
+    if deferred:
+        raw_lines = np.empty((n_ch, min(sb, nseg), np.arange(nf)[lines].size), complex)  # one block's
+        line_power = np.zeros(raw_lines.shape[::2])    # detrended power at those lines, summed
 
     def work(segs, chunks, s0):
         """Sums over the segment batches this thread takes from the shared chunk iterator (powers
@@ -184,9 +194,12 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
     def _work(segs, chunks, s0):
         au = np.zeros((n_ch, 2 * nf)) if reducer == "sum" else np.full((n_ch, nf), -np.inf)
         cr = np.zeros((len(pairs), nf), complex)
-        buf = np.empty((BATCH, nperseg), dtype)           # one windowed batch, reused (no allocation per batch)
-        pad = np.zeros((BATCH, nfft), dtype) if nfft > nperseg else None
-        out = (np.empty((BATCH, nf), np.complex64 if dtype == np.float32 else complex)
+        buf = _scratch("win", (BATCH, nperseg), dtype)    # one windowed batch, reused (no allocation per batch)
+        pad = None
+        if nfft > nperseg:
+            pad = _scratch("pad", (BATCH, nfft), dtype)
+            pad[:, nperseg:] = 0
+        out = (_scratch("fft", (BATCH, nf), np.complex64 if dtype == np.float32 else complex)
                if _NUMPY_FFT_OUT else None)             # one transformed batch, reused
         for b0, b1 in chunks:   # list iterators hand out each chunk once, also across threads (GIL)
             Xs = []
@@ -204,7 +217,9 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
                     pad[:m, :nperseg] = yw
                     yw = pad[:m]
                 X = np.fft.rfft(yw, axis=-1, out=out[:m]) if out is not None else _fft.rfft(yw, axis=-1)
-                if sparse:
+                if deferred:
+                    raw_lines[c, b0:b1] = X[:, lines]
+                elif sparse:
                     X[:, lines] -= np.multiply.outer(y.sum(axis=-1), W_mean)
                 if pairs:   # the buffer is the next channel's too: a copy whenever it is in use
                     Xs.append(X.copy() if reducer == "sum" and not keep_segments or out is not None else X)
@@ -266,11 +281,16 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
             strides=(block.strides[0], block.strides[1] * step, block.strides[1]), writeable=False)
         m = s1 - s0
         chunks = iter([(b, min(m, b + BATCH)) for b in range(0, m, BATCH)])
-        if pool is None or m < 2 * BATCH:
-            parts = [work(segs, chunks, s0)]
-        else:  # this thread works too, and takes more batches when the other core is slow to start
+        fut = None
+        if pool is not None and m >= 2 * BATCH:
+            # this thread works too, and takes more batches when the other core is slow to start
             fut = pool.submit(work, segs, chunks, s0)
-            parts = [work(segs, chunks, s0), fut.result()]
+        if deferred:   # while the other thread starts
+            seg_sums = _segment_totals(block, segs, step, nperseg)
+        parts = [work(segs, chunks, s0)] + ([fut.result()] if fut is not None else [])
+        if deferred:
+            d = raw_lines[:, :m] - seg_sums[:, :, None] * W_mean
+            line_power += (d.real ** 2 + d.imag ** 2).sum(axis=1)
         for au, cr in parts:
             if reducer == "sum":
                 autos += au
@@ -292,7 +312,26 @@ def _segment_sums(src, idx, *, nperseg, noverlap, nfft, win, detrend, pairs=(), 
                                  "this segment length; rescale the record (choose another unit)")
         if progress is not None:
             progress(s1 / nseg)
+    if deferred:
+        autos[:, lines] = line_power
     return autos, crosses, nseg, per_seg
+
+
+def _segment_totals(block, segs, step, nperseg):
+    """Sum of every segment of a block, (n_ch, n_seg). Overlapping segments share samples: when the
+    block's rows are contiguous and a segment is at most 8 parts of g = gcd(step, nperseg) samples,
+    the sums are built from sums over those parts, each sample read once."""
+    g = math.gcd(step, nperseg)
+    q, r = step // g, nperseg // g
+    n_ch, m = segs.shape[:2]
+    if r > 8 or g < 32 or block.strides[1] != block.itemsize:
+        return segs.sum(axis=-1, dtype=float)
+    nb = (m - 1) * q + r
+    parts = block[:, :nb * g].reshape(n_ch, nb, g).sum(axis=-1, dtype=float)
+    tot = parts[:, 0:(m - 1) * q + 1:q].copy()
+    for j in range(1, r):
+        tot += parts[:, j:j + (m - 1) * q + 1:q]
+    return tot
 
 
 PREFETCH_BYTES = 1 << 26   # two blocks of a source on disk are held (one read ahead) when they fit in this
@@ -309,15 +348,33 @@ def _io_pool():
 
 _IO_POOL = None
 _POOL = None
+_SCRATCH = threading.local()
+
+
+SCRATCH_BYTES = 1 << 22   # work buffers up to this size are kept by each thread between calls
+
+
+def _scratch(key, shape, dtype) -> np.ndarray:
+    """A work buffer the calling thread keeps between calls (when it is at most SCRATCH_BYTES; a
+    larger one is allocated per call). A fresh buffer of this size is mapped anew whenever other
+    work has freed large arrays in between, and each of its 4 kB pages then faults on first touch:
+    at 2^18 samples that cost half as much again as psd itself."""
+    if np.dtype(dtype).itemsize * math.prod(shape) > SCRATCH_BYTES:
+        return np.empty(shape, dtype)
+    store = _SCRATCH.__dict__
+    a = store.get(key)
+    if a is None or a.shape != shape or a.dtype != dtype:
+        a = store[key] = np.empty(shape, dtype)
+    return a
 
 
 def _pool():
     """Two worker threads (numpy and the FFT release the GIL) on machines with two or more cores."""
     global _POOL
-    import os
-    if (os.cpu_count() or 1) < 2:
-        return None
     if _POOL is None:
+        import os
+        if (os.cpu_count() or 1) < 2:
+            return None
         from concurrent.futures import ThreadPoolExecutor
         _POOL = ThreadPoolExecutor(max_workers=2, thread_name_prefix="vibmeasure-fft")
     return _POOL
