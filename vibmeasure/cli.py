@@ -148,6 +148,10 @@ def _parser() -> argparse.ArgumentParser:
                                                        "all named). Default: every channel of the file")
     dg.add_argument("--prewhitening", nargs="+", choices=("cepstral", "ar"), default=["cepstral"],
                     help="pre-whitening before envelope analysis (default cepstral)")
+    dg.add_argument("--tach", metavar="CHANNEL", help="tachometer or encoder channel: the speed is measured from its "
+                                                      "pulses and, when it varies, the analysis runs in orders")
+    dg.add_argument("--pulses-per-rev", type=int, default=1, metavar="N",
+                    help="tachometer pulses per shaft revolution (default 1)")
     dg.add_argument("--json", action="store_true", help="print one JSON document")
     dg.add_argument("--plot", metavar="OUT.png", help="spectra with the fault lines and a severity gauge")
 
@@ -400,8 +404,16 @@ def _main_diagnose(args, out, err) -> int:
     from .models.bearing import Bearing
     from .monitor.machinery import diagnose
     try:
+        wanted = args.channel
+        if args.tach and wanted and args.tach not in wanted:
+            wanted = wanted + [args.tach]
         rec = io.read(args.file, fs=args.fs, unit=args.unit, quantity="acceleration" if args.unit else None,
-                      channels=args.channel)
+                      channels=wanted)
+        if args.tach and args.tach not in rec.names:
+            raise VibMeasureError(f"--tach {args.tach!r} is not a channel of {args.file}: {rec.names}")
+        primary = next((i for i, n in enumerate(rec.names) if n != args.tach), None)
+        if primary is None:
+            raise VibMeasureError(f"{args.file} holds only the tachometer channel {args.tach!r}")
         bearing = args.bearing
         if args.bearing_geometry:
             try:
@@ -410,8 +422,8 @@ def _main_diagnose(args, out, err) -> int:
                 raise VibMeasureError(f"--bearing-geometry {args.bearing_geometry!r} must be N,d,D,angle") from None
             bearing = Bearing(int(n), d, D, ang)
         diag = diagnose(rec, rpm=args.rpm, bearing=bearing, gear=args.gear, machine_group=args.group,
-                        foundation=args.foundation, channel=0, line_frequency=args.line_frequency,
-                        prewhitening=tuple(args.prewhitening))
+                        foundation=args.foundation, channel=primary, line_frequency=args.line_frequency,
+                        prewhitening=tuple(args.prewhitening), tach=args.tach, pulses_per_rev=args.pulses_per_rev)
         if args.plot:
             axes = _plot_module().plot_diagnosis(rec, diag)
             _save_figure(axes[0].figure, args.plot)
@@ -429,9 +441,14 @@ def _main_diagnose(args, out, err) -> int:
         print(f"  {diag.reason}", file=out)
         if not diag.bearing_checked:
             print("  bearing faults: not checked (give --bearing or --bearing-geometry)", file=out)
-        est = diag.speed.get("estimated_rpm")
-        print(f"  speed: declared {diag.speed['declared_rpm']:g} rpm, estimated "
-              f"{'n/a' if est is None else format(est, '.1f')} rpm {diag.speed['note']}", file=out)
+        est, dec = diag.speed.get("estimated_rpm"), diag.speed.get("declared_rpm")
+        if diag.speed.get("source"):
+            print(f"  speed: {est:.1f} rpm mean, {diag.speed['min_rpm']:.1f}-{diag.speed['max_rpm']:.1f} rpm "
+                  f"(from the {diag.speed['source']}{'' if dec is None else f'; declared {dec:g} rpm'}) "
+                  f"{diag.speed['note']}", file=out)
+        else:
+            print(f"  speed: declared {dec:g} rpm, estimated "
+                  f"{'n/a' if est is None else format(est, '.1f')} rpm {diag.speed['note']}", file=out)
         if sev.get("velocity_rms_mm_s") is None and "unit_unknown" in diag.flags:
             print("  severity: not computed, the unit is unknown (give --unit): shaft-order faults are not "
                   "gated by the ISO level", file=out)

@@ -44,6 +44,9 @@ FLAG_ADVICE = {
     "bearing_not_checked": "give the bearing (catalogue name or geometry) so bearing faults are searched",
     "band_limited": "record a wider band (sample faster, open the anti-alias filter): bearing impacts ring in "
                     "resonances well above the shaft harmonics",
+    "speed_varies": "record a tachometer or encoder with the vibration (tach=, --tach) or give the speed profile "
+                    "(rpm_profile=), or measure at a steady speed",
+    "order_tracked": "frequencies are orders x the mean speed; check the tachometer's pulses per revolution",
 }
 
 

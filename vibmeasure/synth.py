@@ -260,10 +260,10 @@ def _impact_train(n, fs, times, resonance_hz, amp=None):
     return out / max(np.std(out), 1e-300)
 
 
-def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, duration: float = 10.0,
+def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: float = 10.0,
             severity: float = 1.0, snr_db: float = 20.0, bearing=None, gear_teeth: int = 32,
             resonance_hz: float = 3500.0, cage_modulation: float = 0.0, shaft_impacts: float = 0.0,
-            seed=None, unit: str = "g") -> Record:
+            seed=None, unit: str = "g", tach: int = 0) -> Record:
     """Accelerometer record of a rotating machine, healthy or with one fault, for tests and demos.
 
     Every machine has a small residual 1X and broadband noise. Faults: unbalance (strong 1X),
@@ -276,56 +276,85 @@ def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, du
     healthy bearing; ``shaft_impacts`` (relative to the fault signal's RMS, or to 0.3 g without a
     fault) adds one impact per revolution exciting the resonance (a rub): its envelope is a comb of
     shaft harmonics. The fault-free part is in g; meta holds rpm and the truth.
+
+    ``rpm=(start, end)`` runs the shaft up (or down) linearly over the record: every shaft-, gear- and
+    bearing-rate event then follows the shaft angle, while the structural resonances stay put in Hz;
+    meta["rpm"] is the mean speed. ``tach=N`` adds a channel "tach" with N pulses (0 -> 5 V) per
+    revolution, as a tachometer or encoder gives.
     """
     from .models.bearing import BEARINGS, Bearing
     if fault not in _FAULTS:
         raise ParameterError(f"fault={fault!r} must be one of {_FAULTS}")
-    fs, duration, rpm = positive(fs, "fs"), positive(duration, "duration"), positive(rpm, "rpm")
+    fs, duration = positive(fs, "fs"), positive(duration, "duration")
+    ramp = isinstance(rpm, (tuple, list, np.ndarray))
+    if ramp:
+        if len(rpm) != 2:
+            raise ParameterError(f"rpm={rpm!r} must be one speed or a (start, end) pair for a linear run-up")
+        rpm0, rpm1 = positive(rpm[0], "rpm[0]"), positive(rpm[1], "rpm[1]")
+        rpm = (rpm0 + rpm1) / 2
+    else:
+        rpm = positive(rpm, "rpm")
+    if isinstance(tach, bool) or not isinstance(tach, (int, np.integer)) or tach < 0:
+        raise ParameterError(f"tach={tach!r} must be a whole number of pulses per revolution (0: no tachometer)")
     rng = np.random.default_rng(seed)
     n = int(round(fs * duration))
     t = np.arange(n) / fs
     f1 = rpm / 60.0
+    # shaft angle in revolutions; at constant speed every phase below is computed as before (same samples)
+    theta = (rpm0 * t + (rpm1 - rpm0) * t ** 2 / (2 * duration)) / 60.0 if ramp else None
+
+    def shaft_phase(k):
+        return 2 * np.pi * k * theta if ramp else 2 * np.pi * k * f1 * t
+
+    def at_angle(revs):
+        """Times at which the shaft reaches the given angles (revolutions)."""
+        return np.interp(revs, theta, t, right=np.inf) if ramp else np.asarray(revs) / f1
     b = bearing if isinstance(bearing, Bearing) else BEARINGS["6205-2RS"] if bearing is None else BEARINGS[bearing]
-    base = 0.02 * np.sin(2 * np.pi * f1 * t + rng.uniform(0, 2 * np.pi))  # residual unbalance, healthy level
+    base = 0.02 * np.sin(shaft_phase(1) + rng.uniform(0, 2 * np.pi))  # residual unbalance, healthy level
     sig = np.zeros(n)
     ph = lambda: rng.uniform(0, 2 * np.pi)  # noqa: E731
     if fault == "unbalance":
-        sig = 0.25 * np.sin(2 * np.pi * f1 * t + ph())
+        sig = 0.25 * np.sin(shaft_phase(1) + ph())
     elif fault == "misalignment":
-        sig = 0.08 * np.sin(2 * np.pi * f1 * t + ph()) + 0.5 * np.sin(2 * np.pi * 2 * f1 * t + ph()) \
-            + 0.15 * np.sin(2 * np.pi * 3 * f1 * t + ph())
+        sig = 0.08 * np.sin(shaft_phase(1) + ph()) + 0.5 * np.sin(shaft_phase(2) + ph()) \
+            + 0.15 * np.sin(shaft_phase(3) + ph())
     elif fault == "looseness":
         for k, a in [(0.5, 0.08), (1, 0.1), (1.5, 0.06), (2, 0.1), (3, 0.1), (4, 0.1), (5, 0.08), (6, 0.08),
                      (7, 0.06), (8, 0.06)]:
-            sig += a * np.sin(2 * np.pi * k * f1 * t + ph())
+            sig += a * np.sin(shaft_phase(k) + ph())
     elif fault.startswith("bearing"):
         fr = b.frequencies(f1)
         # a ball defect strikes the inner and the outer race once per ball spin each: 2 x BSF
         ff = {"bearing_outer_race": fr["BPFO"], "bearing_inner_race": fr["BPFI"], "bearing_ball": fr["2xBSF"]}[fault]
-        period = 1.0 / ff
+        if ramp:   # the same events at equal steps of shaft angle (revolutions per impact: f1 / ff)
+            step, end = f1 / ff, theta[-1]
+        else:
+            step, end = 1.0 / ff, duration
         times = []
-        tk = rng.uniform(0, period)
-        while tk < duration:
+        tk = rng.uniform(0, step)
+        while tk < end:
             times.append(tk)
-            tk += period * (1 + 0.01 * rng.normal())  # rolling elements slip: 1 % jitter
-        times = np.asarray(times)
+            tk += step * (1 + 0.01 * rng.normal())  # rolling elements slip: 1 % jitter
+        revs = np.asarray(times) if ramp else None
+        times = at_angle(revs) if ramp else np.asarray(times)
         amp = np.ones_like(times)
-        if fault == "bearing_inner_race":
-            amp = 1 + 0.8 * np.cos(2 * np.pi * f1 * times)       # the defect turns with the shaft
-        elif fault == "bearing_ball":
-            amp = 1 + 0.8 * np.cos(2 * np.pi * fr["FTF"] * times)  # the ball travels with the cage
+        if fault == "bearing_inner_race":    # the defect turns with the shaft
+            amp = 1 + 0.8 * np.cos(2 * np.pi * revs if ramp else 2 * np.pi * f1 * times)
+        elif fault == "bearing_ball":        # the ball travels with the cage
+            amp = 1 + 0.8 * np.cos(2 * np.pi * fr["FTF"] / f1 * revs if ramp else 2 * np.pi * fr["FTF"] * times)
         sig = 0.3 * _impact_train(n, fs, times, resonance_hz, amp)  # resonance with zeta 0.05
     elif fault == "gear_mesh":
         fm = gear_teeth * f1
-        sig = 0.3 * (1 + 0.5 * np.cos(2 * np.pi * f1 * t)) * np.sin(2 * np.pi * fm * t + ph()) \
-            + 0.1 * np.sin(2 * np.pi * 2 * fm * t + ph())
+        mesh = (lambda k: 2 * np.pi * k * gear_teeth * theta) if ramp else (lambda k: 2 * np.pi * k * fm * t)
+        sig = 0.3 * (1 + 0.5 * np.cos(shaft_phase(1))) * np.sin(mesh(1) + ph()) \
+            + 0.1 * np.sin(mesh(2) + ph())
     elif fault == "resonance":
         # a structural mode (zeta 0.04) 6 % above 1X: the running speed's force and the broadband
         # forces both come out amplified, the latter as a hump in the noise floor
         from scipy.signal import cont2discrete, lfilter
         wr = 2 * np.pi * 1.06 * f1
         bz, az, _ = cont2discrete(([wr ** 2], [1.0, 2 * 0.04 * wr, wr ** 2]), 1 / fs, method="zoh")
-        drive = 0.02 * np.sin(2 * np.pi * f1 * t + ph()) + 0.05 * rng.normal(size=n)
+        drive = 0.02 * np.sin(shaft_phase(1) + ph()) + 0.05 * rng.normal(size=n)
         sig = lfilter(np.ravel(bz), az, drive) * 2.0
     sig = severity * sig
     p_sig = np.mean(sig ** 2) if fault != "none" else np.mean((0.3 * np.ones(1)) ** 2) / 2
@@ -334,18 +363,25 @@ def machine(*, fault: str = "none", rpm: float = 1797.0, fs: float = 12000.0, du
     if cage_modulation > 1:
         raise ParameterError(f"{cage_modulation=} must be between 0 and 1 (modulation depth)")
     if cage_modulation:
-        th = 2 * np.pi * b.frequencies(f1)["FTF"] * t + rng.uniform(0, 2 * np.pi)
+        ftf = b.frequencies(f1)["FTF"]
+        th = (2 * np.pi * ftf / f1 * theta if ramp else 2 * np.pi * ftf * t) + rng.uniform(0, 2 * np.pi)
         noise *= 1 + cage_modulation * (np.cos(th) + 0.5 * np.cos(2 * th) + 0.3 * np.cos(3 * th)) / 1.8
     shaft_impacts = positive(shaft_impacts, "shaft_impacts", allow_zero=True)
     if shaft_impacts:
-        sig = sig + shaft_impacts * np.sqrt(2 * p_sig) * _impact_train(n, fs, np.arange(rng.uniform(0, 1 / f1),
-                                                                                       duration, 1 / f1),
-                                                                       resonance_hz)
+        marks = (at_angle(np.arange(rng.uniform(0, 1), theta[-1], 1.0)) if ramp
+                 else np.arange(rng.uniform(0, 1 / f1), duration, 1 / f1))
+        sig = sig + shaft_impacts * np.sqrt(2 * p_sig) * _impact_train(n, fs, marks, resonance_hz)
     x = base + sig + noise
     from .core.record import Channel as _Ch
     truth = {"kind": "machine", "fault": fault, "rpm": rpm, "severity": severity, "snr_db": snr_db}
-    return Record(x, fs, (_Ch("acc", "acceleration", unit),), meta={"rpm": rpm, "truth": truth},
-                  history=(f"synth machine {fault}",))
+    channels = (_Ch("acc", "acceleration", unit),)
+    if ramp:
+        truth["rpm_range"] = (rpm0, rpm1)
+    if tach:
+        ang = theta if ramp else f1 * t
+        x = np.vstack([x, 5.0 * (np.mod(ang * tach, 1.0) < 0.25)])
+        channels += (_Ch("tach", "unknown", "V"),)
+    return Record(x, fs, channels, meta={"rpm": rpm, "truth": truth}, history=(f"synth machine {fault}",))
 
 
 def fleet(folder=None, *, n_measurements: int = 52, start: str = "2026-01-05", interval_days: float = 7.0,

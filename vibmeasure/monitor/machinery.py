@@ -125,7 +125,14 @@ def _accel(rec, i, flags):
     return x
 
 
-def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band) -> _Job:
+def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band, skip=()) -> _Job:
+    """``skip``: channels that are no vibration (a tachometer), left out unless named."""
+    if channel is None and skip:
+        left = [i for i, c in enumerate(rec.channels) if i not in skip and c.quantity != "force"]
+        if not left:
+            raise ParameterError(f"the record's only channels {rec.names} are the tachometer or forces: "
+                                 "it needs a vibration channel")
+        channel = left[0]
     idx = response_channel(rec, channel)
     if rpm is None:
         rpm = rec.meta.get("rpm")
@@ -151,7 +158,7 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
     flags: list = []
     a = _accel(rec, idx, flags)
     if channels is None:
-        chosen = [i for i, c in enumerate(rec.channels) if c.quantity not in ("force", "time")]
+        chosen = [i for i, c in enumerate(rec.channels) if c.quantity not in ("force", "time") and i not in skip]
     else:
         chosen = [rec.index(c) for c in ([channels] if isinstance(channels, (str, int)) else channels)]
     if idx not in chosen:
@@ -217,6 +224,126 @@ def _speed(job: _Job, f, A):
             break
     if speed["consistent"] and snr1 < LINE_DB:
         speed["note"] = f"no 1X line within 3 % of the declared {job.rpm:g} rpm"
+    if speed["consistent"]:
+        drift = _speed_drift(job.a, job.fs, f1)
+        if drift is not None and drift[2] > SPEED_DRIFT:
+            lo, hi, spread = drift
+            speed.update(drift_hz=(lo, hi), note=(
+                f"the 1X line moves between {lo:.2f} and {hi:.2f} Hz over the record ({100 * spread:.1f} %): the "
+                "speed varies and the bearing lines smear; give tach= or rpm_profile= for an analysis in orders"))
+            job.flags.append("speed_varies")
+            job.bearing_weak = True
+    return speed, f1
+
+
+SPEED_DRIFT = 0.02   # the 1X line may wander this much (share of its mean) before the speed is said to vary
+# Measured with _speed_drift on every channel of the 57 development records (constant speed): at most
+# 1.08 % on the 146 channels where the 1X stands in enough parts (the 8 MFPT channels' 1X is too weak to
+# track); Normal_0's 20 % comes from its wrong declared fs, which is flagged before this is looked at.
+
+
+def _speed_drift(a, fs, f1, n_seg=8):
+    """(lowest, highest, spread) of the 1X line's frequency over n_seg parts of the record, from the
+    parts where it stands LINE_DB above its floor (at least 5 of them; else None)."""
+    n_seg = min(n_seg, int(a.size / fs * f1 / 8))     # each part spans 8 revolutions or more
+    if n_seg < 4:
+        return None
+    L = a.size // n_seg
+    w = np.hanning(L)
+    f = np.fft.rfftfreq(L, 1 / fs)
+    sel = np.flatnonzero((f > 0.75 * f1) & (f < 1.25 * f1))
+    if sel.size < 3 or sel[0] < 1:
+        return None
+    A = np.abs(np.fft.rfft(a[: n_seg * L].reshape(n_seg, L) * w, axis=1))
+    found = []
+    for row in A:
+        k = sel[np.argmax(row[sel])]
+        ring = (np.abs(f - f[k]) < max(0.25 * f1, 12 * f[1])) & (np.abs(f - f[k]) > 3 * f[1])
+        if ring.sum() < 5 or 20 * np.log10(row[k] / max(np.median(row[ring]), 1e-300)) < LINE_DB:
+            continue
+        found.append(_refine(f, row, f[k]))
+    if len(found) < 5:
+        return None
+    lo, hi = min(found), max(found)
+    return lo, hi, (hi - lo) / float(np.mean(found))
+
+
+VARYING_SPEED = 0.002   # above this spread of the mean speeds of the record's parts, the analysis runs in orders
+
+
+def _measured_speed(rec, tach, rpm_profile, pulses_per_rev) -> dict:
+    """Shaft angle (revolutions) per sample from a tachometer or an rpm profile, and the speed's range
+    over whole revolutions."""
+    from ..signal.demod import _shaft_angle
+    if isinstance(pulses_per_rev, bool) or not isinstance(pulses_per_rev, (int, np.integer)) or pulses_per_rev < 1:
+        raise ParameterError(f"pulses_per_rev={pulses_per_rev!r} must be a whole number >= 1")
+    if tach is not None and rpm_profile is not None:
+        raise ParameterError("give tach or rpm_profile, not both")
+    if tach is not None and not isinstance(tach, (str, int, np.integer)):
+        tach = np.asarray(tach, float)
+        if tach.ndim != 1 or not np.isfinite(tach).all():
+            raise ParameterError("tach must be a channel name or index, or one finite sample per record sample")
+    ang = _shaft_angle(rec, tach=tach, rpm_profile=rpm_profile, pulses_per_rev=pulses_per_rev)
+    ok = np.flatnonzero(np.isfinite(ang))
+    t = np.arange(rec.n_samples) / rec.fs
+    revs = np.arange(np.ceil(ang[ok[0]]), np.floor(ang[ok[-1]]) + 1)
+    if revs.size < 21:
+        raise ParameterError(f"the speed information covers {max(revs.size - 1, 0)} whole revolutions; at least 20 "
+                             "are needed")
+    t_rev = np.interp(revs, ang[ok], t[ok])
+    # per revolution, averaged over 5: a square pulse is timed to +-half a sample, +-0.25 % of a
+    # revolution of 400 samples, and that jitter is no change of speed
+    per_rev = np.convolve(60.0 / np.diff(t_rev), np.ones(5) / 5, mode="valid")
+    # whether the speed varies: mean speed over up to 8 parts of 8 or more revolutions each
+    n_p = int(min(8, (revs.size - 1) // 8))
+    edges = np.linspace(0, revs.size - 1, n_p + 1).round().astype(int)
+    parts = 60.0 * np.diff(revs[edges]) / np.diff(t_rev[edges])
+    mean = 60.0 * float((ang[ok[-1]] - ang[ok[0]]) / (t[ok[-1]] - t[ok[0]]))
+    return {"angle": ang, "valid": (int(ok[0]), int(ok[-1]) + 1), "mean_rpm": mean,
+            "min_rpm": float(per_rev.min()), "max_rpm": float(per_rev.max()),
+            "spread": float(parts.max() - parts.min()) / mean,
+            "source": "tachometer" if tach is not None else "rpm profile"}
+
+
+def _order_tracked_job(job: _Job, n: int, tracked: dict, band):
+    """The job with every channel resampled at equal steps of shaft angle when the speed varies: its
+    'fs' is the angular rate at the mean speed (samples per revolution x mean revolutions per second),
+    so every Hz below is an order x the mean speed. A constant speed keeps the record as measured."""
+    from dataclasses import replace
+    f_mean = tracked["mean_rpm"] / 60.0
+    if tracked["spread"] <= VARYING_SPEED:
+        return replace(job, rpm=tracked["mean_rpm"]), ""
+    if band is not None:
+        raise ParameterError("band= is in Hz, but this record's speed varies and the bands are searched in orders "
+                             "after angular resampling: leave band unset")
+    from scipy.interpolate import CubicSpline
+    ang = tracked["angle"]
+    i0, i1 = tracked["valid"]
+    t = np.arange(n) / job.fs
+    spr = job.fs / (tracked["min_rpm"] / 60.0)          # the slowest speed's whole band is kept
+    grid = np.arange(np.ceil(ang[i0] * spr), np.floor(ang[i1 - 1] * spr)) / spr
+    t_grid = np.interp(grid, ang[i0:i1], t[i0:i1])
+    signals = {k: CubicSpline(t, x)(t_grid) for k, x in job.signals.items()}
+    note = (f"speed {tracked['min_rpm']:.0f}-{tracked['max_rpm']:.0f} rpm (from the {tracked['source']}): shaft "
+            f"orders and bearing lines analysed after angular resampling; frequencies are orders x the mean "
+            f"speed {f_mean:.2f} Hz")
+    out = replace(job, fs=spr * f_mean, rpm=tracked["mean_rpm"], signals=signals, a=signals[job.primary],
+                  flags=job.flags + ["order_tracked"])
+    return out, note
+
+
+def _tach_speed(job: _Job, f, A, tracked: dict, declared, note: str):
+    """The speed as the tachometer (or profile) gives it; the declared rpm is compared with it."""
+    f1 = tracked["mean_rpm"] / 60.0
+    _, _, snr1 = _line(f, A, f1, max(0.03 * f1, 2 * f[1]), f1 + 5 * f[1])
+    speed = {"declared_rpm": declared, "estimated_rpm": tracked["mean_rpm"], "one_x_db": snr1, "consistent": True,
+             "note": note, "fs_ratio": 1, "source": tracked["source"], "min_rpm": tracked["min_rpm"],
+             "max_rpm": tracked["max_rpm"]}
+    if declared is not None and abs(declared / tracked["mean_rpm"] - 1) > 0.03:
+        speed["note"] = (note + "; " if note else "") + (
+            f"the declared {declared:g} rpm is not the {tracked['source']}'s mean {tracked['mean_rpm']:.0f} rpm: "
+            "the measured speed is used")
+        job.flags.append("speed_inconsistent")
     return speed, f1
 
 
@@ -353,7 +480,7 @@ def _p_none(table) -> tuple[float, float]:
 def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_group: int | None = None,
              foundation: str | None = None, channel=None, channels=None, band=None,
              prewhitening=("cepstral",), line_frequency: float | None = None,
-             fs: float | None = None) -> Diagnosis:
+             fs: float | None = None, tach=None, pulses_per_rev: int = 1, rpm_profile=None) -> Diagnosis:
     """Diagnose a rotating machine from an acceleration record.
 
     ``rpm`` is the declared shaft speed (default: the record's meta["rpm"]); ``bearing`` a vm.Bearing
@@ -366,14 +493,31 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     names the pre-processings searched: "cepstral" (default) and/or "ar" (shaft-synchronous part and
     discrete lines removed, then AR whitening). ``line_frequency``
     (50 or 60 Hz) adds the electrical check at twice the line frequency.
+
+    A speed that varies over the record: give ``tach`` (the tachometer or encoder channel, by name or
+    index, or its samples; ``pulses_per_rev`` pulses per revolution) or ``rpm_profile`` (one rpm per
+    sample). ``rpm`` then defaults to the mean speed. When the mean speeds of up to 8 parts of the
+    record differ by more than ``VARYING_SPEED`` (0.2 %), every channel is resampled at equal steps of shaft angle and the
+    shaft-order and bearing analyses run in orders (cepstral pre-whitening after order tracking:
+    Borghesani et al. 2013); frequencies are then given as orders x the mean speed, flag
+    ``order_tracked``. The ISO severity is taken from the record as measured.
     """
     from . import shaft_faults as sf
     rec = as_record(rec, fs=fs)
-    job = _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band)
+    tracked = None
+    if tach is not None or rpm_profile is not None:
+        tracked = _measured_speed(rec, tach, rpm_profile, pulses_per_rev)
+        if rpm is None:
+            rpm = tracked["mean_rpm"]
+    skip = (rec.index(tach),) if isinstance(tach, (str, int)) and not isinstance(tach, bool) else ()
+    job = _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band, skip)
     job.prewhitening = _check_prewhitening(prewhitening)
+    measured = job
+    if tracked is not None:
+        job, note = _order_tracked_job(job, rec.n_samples, tracked, band)
     f, A, V = _spectrum(job)
-    speed, f1 = _speed(job, f, A)
-    severity, level = _severity(job, f, job.rpm)
+    speed, f1 = _speed(job, f, A) if tracked is None else _tach_speed(job, f, A, tracked, rpm, note)
+    severity, level = _severity(measured, np.fft.rfftfreq(measured.a.size, 1 / measured.fs), measured.rpm)
     v_rms = severity["velocity_rms_mm_s"] if severity["velocity_rms_mm_s"] is not None else np.nan
     rows, order = sf.shaft_order_rows(f, V, f1, v_rms, level, job.flags, _line, _row, LINE_DB)
     rows.append(sf.resonance_row(f, _spectrum(job, "blackmanharris")[1], f1, order, level, rows, _row, LINE_DB))
@@ -387,10 +531,15 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         job.bearing_weak = len(narrow) == len(ev["measured_top_hz"])
     if job.gear is not None:
         rows.append(sf.gear_row(f, A, f1, job.gear, _line, _row, LINE_DB))
+    if "speed_varies" in job.flags:   # 1X and its orders are smeared over the record: nothing to weigh
+        for r in rows:
+            if r["fault"] in SHAFT_FAULTS and r["confidence"] > 0:
+                r["note"] = "not called, the speed varies over the record: " + r["note"]
+                r["confidence"] = 0.0
     import pandas as pd
     table = pd.DataFrame(rows).sort_values("confidence", ascending=False, ignore_index=True)
     top, conf, reason, also, where, (kind, score, parts) = _decide(table, job)
-    if "speed_inconsistent" in job.flags:
+    if {"speed_inconsistent", "order_tracked", "speed_varies"} & set(job.flags):
         reason += "; " + speed["note"]
     if "unit_unknown" in job.flags and top in SHAFT_FAULTS:
         reason += ("; the data's unit is unknown, so this shaft-order fault was not weighed against the ISO "
