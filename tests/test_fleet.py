@@ -255,6 +255,23 @@ def test_manifest_rules(tmp_path):
         vm.batch(tmp_path, task="fft", store=tmp_path / "s.h5")
 
 
+def test_a_manifest_names_the_tachometer_of_run_ups(tmp_path):
+    # two machines run up 1500 -> 2100 rpm; the manifest names the tachometer channel instead of an rpm
+    (tmp_path / "in").mkdir()
+    for i, fault in enumerate(("bearing_inner_race", "none")):
+        vm.write(tmp_path / "in" / f"r{i}.h5", vm.synth.machine(fault=fault, rpm=(1500.0, 2100.0), tach=1, seed=i,
+                                                              snr_db=10, duration=3.0))
+    (tmp_path / "in" / "m.csv").write_text("file,asset,channel,tach,pulses_per_rev,bearing\n"
+                                           "r0.h5,a,acc,tach,1,6205-2RS\nr1.h5,b,acc,tach,1,6205-2RS\n")
+    rep = vm.batch(task="diagnose", store=tmp_path / "s.h5", manifest=tmp_path / "in" / "m.csv")
+    assert list(rep["status"]) == ["done", "done"]
+    diag = vm.Store(tmp_path / "s.h5").results("diagnose")
+    assert dict(zip(diag["asset"], diag["top"])) == {"a": "bearing_inner_race", "b": "none"}
+    (tmp_path / "in" / "bad.csv").write_text("file,asset,tach,pulses_per_rev\nr0.h5,a,tach,two\n")
+    with pytest.raises(vm.ParameterError, match="pulses_per_rev='two' is not a whole number"):
+        vm.read_manifest(tmp_path / "in" / "bad.csv")
+
+
 @pytest.fixture(scope="module")
 def cluster():
     distributed = pytest.importorskip("distributed")

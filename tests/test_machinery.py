@@ -343,6 +343,21 @@ def test_speed_information_bad_input():
         vm.diagnose(vm.Record(rec.data[1:], rec.fs, [vm.Channel("tach", "unknown", "V")]), tach="tach")
 
 
+def test_plot_of_an_order_tracked_diagnosis_says_so(tmp_path):
+    import matplotlib
+    matplotlib.use("Agg")
+    from vibmeasure.plot import plot_diagnosis
+    rec = _run_up("bearing_outer_race")
+    d = vm.diagnose(rec, tach="tach", bearing="6205-2RS")
+    ax_e, ax_s, ax_g, ax_k = plot_diagnosis(rec, d)
+    assert ax_e.get_xlabel().startswith("order x the mean speed 30.0")   # 1800 rpm: 30 Hz
+    assert any("the diagnosis ran in orders" in t.get_text() for t in ax_s.texts)
+    plain = vm.diagnose(rec, rpm=1800, bearing="6205-2RS", channels=["acc"])
+    if "speed_varies" in plain.flags:
+        ax_e, ax_s, _, _ = plot_diagnosis(rec.select("acc"), plain)
+        assert any("no tachometer" in t.get_text() for t in ax_s.texts) and ax_e.get_xlabel() == "frequency [Hz]"
+
+
 def test_cli_diagnose_with_a_tachometer(tmp_path):
     from tests.test_cli import run
     path = tmp_path / "runup.h5"

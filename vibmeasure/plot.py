@@ -385,6 +385,16 @@ def plot_diagnosis(rec, diag, *, axes=None):
     if "speed_inconsistent" in diag.flags or not diag.speed.get("consistent", True):
         ax_s.text(0.5, 0.9, "WARNING: the speed check failed (see the diagnosis flags)", transform=ax_s.transAxes,
                   ha="center", color="C3", fontsize=9, fontweight="bold")
+    elif "order_tracked" in diag.flags or "speed_varies" in diag.flags:
+        msg = ("the speed varies over the record: lines smear in this spectrum (the diagnosis ran in orders)"
+               if "order_tracked" in diag.flags else
+               "WARNING: the speed varies over the record and no tachometer was given: lines smear")
+        ax_s.text(0.5, 0.9, msg, transform=ax_s.transAxes, ha="center", fontsize=8,
+                  color="0.2" if "order_tracked" in diag.flags else "C3")
+    if "order_tracked" in diag.flags:   # the SES and the kurtogram are in orders x the mean speed
+        for ax in (ax_e, ax_k):
+            if ax is not None and ax.get_xlabel():
+                ax.set_xlabel(f"order x the mean speed {f1:.2f} Hz [Hz]")
     sev = diag.severity
     from .monitor.machinery import ISO_10816_3
     ab, bc, cd = ISO_10816_3[(sev["group"], sev["foundation"])]

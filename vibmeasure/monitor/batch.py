@@ -1,7 +1,8 @@
 """Batch analysis into a measurement store, serially or on a Dask cluster.
 
 Inputs are files, folders and globs, with an optional manifest (CSV: ``file`` (name or glob relative
-to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``model``, ``time``).
+to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``model``, ``time``, and for a
+speed that varies ``tach`` (the tachometer channel) and ``pulses_per_rev``).
 Each input is read and analysed by a pure function (:func:`analyse_file`) that returns plain data;
 with Dask the workers run it and only the client writes the store, committing every few dozen
 results. One bad file never stops the batch: its error is stored and listed. Inputs whose content
@@ -25,7 +26,7 @@ from ..io._common import file_sha256
 __all__ = ["batch", "read_manifest", "analyse_file", "TASKS", "MANIFEST_COLUMNS"]
 
 TASKS = ("ringdown", "modes", "spectrum", "diagnose", "compare")
-MANIFEST_COLUMNS = ("file", "asset", "point", "channel", "rpm", "bearing", "model", "time")
+MANIFEST_COLUMNS = ("file", "asset", "point", "channel", "rpm", "bearing", "model", "time", "tach", "pulses_per_rev")
 READABLE = (".csv", ".txt", ".h5", ".hdf5", ".wav", ".mat", ".lvm", ".uff", ".unv")
 COMMIT_EVERY = 50       # inputs per commit (each commit rewrites the store: see io/store.py)
 MAX_PER_TASK = 8        # inputs per Dask task at most (fewer when the batch is small: every worker keeps busy)
@@ -76,6 +77,12 @@ def read_manifest(path) -> list[dict]:
                     row["rpm"] = float(row["rpm"])
                 except ValueError:
                     raise ParameterError(f"manifest {str(path)!r} line {i}: rpm={row['rpm']!r} is not a number") from None
+            if row.get("pulses_per_rev"):
+                try:
+                    row["pulses_per_rev"] = int(row["pulses_per_rev"])
+                except ValueError:
+                    raise ParameterError(f"manifest {str(path)!r} line {i}: pulses_per_rev={row['pulses_per_rev']!r} "
+                                         "is not a whole number") from None
             if row.get("model") and not os.path.isabs(row["model"]):
                 row["model"] = str(p.parent / row["model"])
             for h in hits:
@@ -143,10 +150,12 @@ def _run(task, rec, item, options):
                   "bands": summary}
         return result, summary, {"nperseg": psd.params["nperseg"], "channel": psd.channels[0]}
     if task == "diagnose":
-        rpm = item.get("rpm")
-        if rpm is None:
-            raise ParameterError("task 'diagnose' needs the shaft speed: give rpm in the manifest")
-        d = vm.diagnose(rec, rpm=float(rpm), bearing=item.get("bearing"), channel=ch)
+        rpm, tach = item.get("rpm"), item.get("tach")
+        if rpm is None and tach is None:
+            raise ParameterError("task 'diagnose' needs the shaft speed: give rpm (or a tach channel) in the manifest")
+        d = vm.diagnose(rec, rpm=None if rpm is None else float(rpm), bearing=item.get("bearing"), channel=ch,
+                        tach=tach, pulses_per_rev=item.get("pulses_per_rev") or 1)
+        rpm = d.speed.get("estimated_rpm") if rpm is None else rpm
         sev = d.severity or {}
         summary = {"top": d.top, "confidence": float(d.confidence),
                    "velocity_rms_mm_s": sev.get("velocity_rms_mm_s"), "zone": sev.get("zone"),
