@@ -103,6 +103,26 @@ def _envelope_spectrum_streamed(rec, *, band, channel, nperseg, progress):
                      "band_hz": (lo, hi), "squared": True, "streamed": True})
 
 
+def _rising_edges(p, lvl, hyst):
+    """Samples i with p[i] < lvl <= p[i + 1] where the signal rises through lvl after it was below
+    lvl - hyst, to reach lvl + hyst before it falls again: the noise on a slow edge makes one pulse,
+    not several (a Schmitt trigger)."""
+    state = np.full(p.size, -1)
+    state[p <= lvl - hyst] = 0
+    state[p >= lvl + hyst] = 1
+    known = np.flatnonzero(state >= 0)
+    if known.size < 2:
+        return np.zeros(0, int)
+    s = state[known]
+    turn = np.flatnonzero((s[1:] == 1) & (s[:-1] == 0))        # last low sample -> first high sample
+    lo_i, hi_i = known[turn], known[turn + 1]
+    out = []
+    for a, b in zip(lo_i, hi_i):   # the last crossing of lvl between them (one sample apart on a clean edge)
+        seg = np.flatnonzero(p[a:b] < lvl)
+        out.append(a + seg[-1])
+    return np.asarray(out, int)
+
+
 def _shaft_angle(rec, *, tach=None, rpm_profile=None, pulses_per_rev: int = 1, tach_level: float | None = None):
     """Shaft angle (revolutions) at every sample, from tachometer pulses or an rpm profile."""
     t = np.arange(rec.n_samples) / rec.fs
@@ -113,7 +133,7 @@ def _shaft_angle(rec, *, tach=None, rpm_profile=None, pulses_per_rev: int = 1, t
         if p.shape != t.shape:
             raise ParameterError(f"tach has {p.size} samples; the record has {t.size}")
         lvl = (p.max() + p.min()) / 2 if tach_level is None else tach_level
-        up = np.flatnonzero((p[1:] >= lvl) & (p[:-1] < lvl))
+        up = _rising_edges(p, lvl, 0.1 * (p.max() - p.min()))
         if up.size < 3:
             raise ParameterError(f"tach: {up.size} pulse(s) found at level {lvl:g}; at least 3 are needed")
         # sub-sample crossing times, then the angle is linear between pulses (cubic would overshoot)
