@@ -322,6 +322,7 @@ def _order_tracked_job(job: _Job, n: int, tracked: dict, band):
     t = np.arange(n) / job.fs
     spr = job.fs / (tracked["min_rpm"] / 60.0)          # the slowest speed's whole band is kept
     grid = np.arange(np.ceil(ang[i0] * spr), np.floor(ang[i1 - 1] * spr)) / spr
+    grid = grid[:_fast_len_below(grid.size)]   # a length with small prime factors: the FFTs stay fast
     t_grid = np.interp(grid, ang[i0:i1], t[i0:i1])
     signals = {k: CubicSpline(t, x)(t_grid) for k, x in job.signals.items()}
     note = (f"speed {tracked['min_rpm']:.0f}-{tracked['max_rpm']:.0f} rpm (from the {tracked['source']}): shaft "
@@ -330,6 +331,15 @@ def _order_tracked_job(job: _Job, n: int, tracked: dict, band):
     out = replace(job, fs=spr * f_mean, rpm=tracked["mean_rpm"], signals=signals, a=signals[job.primary],
                   flags=job.flags + ["order_tracked"])
     return out, note
+
+
+def _fast_len_below(n: int) -> int:
+    """The largest length <= n whose prime factors are 2, 3 and 5 (at most ~1 % shorter above 1000)."""
+    from scipy.fft import next_fast_len
+    m = n
+    while m > 1 and next_fast_len(m, real=True) != m:
+        m -= 1
+    return m
 
 
 def _tach_speed(job: _Job, f, A, tracked: dict, declared, note: str):

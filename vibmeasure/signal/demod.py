@@ -115,12 +115,11 @@ def _rising_edges(p, lvl, hyst):
         return np.zeros(0, int)
     s = state[known]
     turn = np.flatnonzero((s[1:] == 1) & (s[:-1] == 0))        # last low sample -> first high sample
-    lo_i, hi_i = known[turn], known[turn + 1]
-    out = []
-    for a, b in zip(lo_i, hi_i):   # the last crossing of lvl between them (one sample apart on a clean edge)
-        seg = np.flatnonzero(p[a:b] < lvl)
-        out.append(a + seg[-1])
-    return np.asarray(out, int)
+    hi_i = known[turn + 1]
+    # the last plain crossing of lvl before each first high sample (there is one: the low sample
+    # before it lies under lvl)
+    cross = np.flatnonzero((p[:-1] < lvl) & (p[1:] >= lvl))
+    return cross[np.searchsorted(cross, hi_i, side="left") - 1]
 
 
 def _shaft_angle(rec, *, tach=None, rpm_profile=None, pulses_per_rev: int = 1, tach_level: float | None = None):
