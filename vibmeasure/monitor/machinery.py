@@ -242,7 +242,7 @@ DRIFT_P = 1e-3       # ... along a curve that a constant speed would follow by c
 # the 1X stands in enough parts, the curve spans at most 0.72 % and none is flagged (the 8 MFPT
 # channels' 1X is too weak to track; Normal_0's wrong declared fs is flagged before this is looked
 # at). On 284 constant-speed synthetic machines (benchmarks/diagnosis.py, SNR -10 to 10 dB) none is
-# flagged: the widest curve, 2.32 %, has p = 0.29. The spread alone (no test) flagged 2 of them.
+# flagged: the widest curve, 2.32 %, has p = 0.29. The spread of the parts alone flagged 3 of them.
 
 
 def _speed_drift(a, fs, f1, n_seg=8):
