@@ -7,8 +7,9 @@ channel and <= 0.6 s with three.
 
 The run-up section diagnoses machines whose speed rises linearly by 40 % over the record (1500 -> 2100
 rpm) three ways: with the tachometer channel (one pulse per revolution; the analysis runs in orders),
-with the rpm profile, and with only the mean speed declared (the 1X drift must be flagged and no fault
-called from smeared lines).
+with the rpm profile, and with only the mean speed declared (where the 1X drifts along a curve, the
+flag speed_varies is set and the speed is estimated from that curve; elsewhere no fault may be called
+from smeared lines).
 
     python benchmarks/diagnosis.py [N]        (N seeds per fault and SNR, default 20)
 """

@@ -294,21 +294,24 @@ def test_a_run_up_with_a_tachometer_is_analysed_in_orders(fault):
     assert p.top == fault and p.speed["source"] == "rpm profile"
 
 
-def test_a_run_up_without_speed_information_is_flagged_and_not_called():
-    # with only the mean speed declared, every line smears over 1500-2100 rpm: the 1X drift is named,
-    # nothing is called from smeared lines, and the "none" is not a confident one (below 0.5; a steady
-    # machine's "none" reads above 0.9)
-    # the drift is seen where the 1X stands in the record's parts (a machine's residual 1X, an
-    # unbalance); a bearing fault's smeared lines are not called either way
-    for fault in ("none", "unbalance"):
-        rec = _run_up(fault)
-        d = vm.diagnose(rec, rpm=1800, bearing="6205-2RS", channels=["acc"])
-        assert d.top == "none" and "speed_varies" in d.flags and d.confidence < 0.5
+def test_a_run_up_without_speed_information_is_followed_by_its_1x():
+    # only the mean speed declared: the 1X drifts along a curve over the record's parts, so the flag
+    # speed_varies is set, the speed is estimated from that curve and the record analysed in orders.
+    # The curve through 8 parts' 1X of a linear ramp is that ramp: 1500-2100 rpm within 2 %
+    for fault in ("unbalance", "looseness", "bearing_outer_race", "none"):
+        d = vm.diagnose(_run_up(fault), rpm=1800, bearing="6205-2RS", channels=["acc"])
+        assert d.top == fault and {"speed_varies", "order_tracked"} <= set(d.flags), d.reason
+        assert d.speed["source"] == "1X line" and "A tachometer (tach=) measures the speed" in d.reason
+        assert d.speed["min_rpm"] == pytest.approx(1500, rel=0.02) and d.speed["max_rpm"] == pytest.approx(2100, rel=0.02)
         lo, hi = d.speed["drift_hz"]
-        # 1X moves from 25 to 35 Hz; each of the 8 parts sees its own mean speed: 25.6 .. 34.4 Hz
+        # the curve spans the parts' middles: 25 + 10/16 .. 35 - 10/16 Hz
         assert lo == pytest.approx(25.0 + 10.0 / 16, abs=0.3) and hi == pytest.approx(35.0 - 10.0 / 16, abs=0.3)
-        assert "give tach= or rpm_profile=" in d.reason
-    assert vm.diagnose(_run_up("bearing_outer_race"), rpm=1800, bearing="6205-2RS", channels=["acc"]).top == "none"
+        if fault == "none":   # the speed was estimated, not measured: a "none" is no confident one
+            assert d.confidence < 0.5
+    # a fixed band in Hz cannot follow the orders: the drift is named and nothing is called
+    d = vm.diagnose(_run_up("unbalance"), rpm=1800, bearing="6205-2RS", channels=["acc"], band=(2000, 4000))
+    assert d.top == "none" and "speed_varies" in d.flags and "order_tracked" not in d.flags
+    assert "give tach= or rpm_profile=" in d.reason
     steady = vm.diagnose(vm.synth.machine(fault="none", tach=1, seed=0, duration=4.0), rpm=1797, bearing="6205-2RS",
                          channels=["acc"])
     assert "speed_varies" not in steady.flags and steady.confidence > 0.9
@@ -352,10 +355,12 @@ def test_plot_of_an_order_tracked_diagnosis_says_so(tmp_path):
     ax_e, ax_s, ax_g, ax_k = plot_diagnosis(rec, d)
     assert ax_e.get_xlabel().startswith("order x the mean speed 30.0")   # 1800 rpm: 30 Hz
     assert any("the diagnosis ran in orders" in t.get_text() for t in ax_s.texts)
-    plain = vm.diagnose(rec, rpm=1800, bearing="6205-2RS", channels=["acc"])
-    if "speed_varies" in plain.flags:
-        ax_e, ax_s, _, _ = plot_diagnosis(rec.select("acc"), plain)
-        assert any("no tachometer" in t.get_text() for t in ax_s.texts) and ax_e.get_xlabel() == "frequency [Hz]"
+    est = vm.diagnose(rec, rpm=1800, bearing="6205-2RS", channels=["acc"])   # the speed from the 1X
+    ax_e, ax_s, _, _ = plot_diagnosis(rec.select("acc"), est)
+    assert any("speed estimated from the 1X" in t.get_text() for t in ax_s.texts)
+    fixed = vm.diagnose(rec, rpm=1800, bearing="6205-2RS", channels=["acc"], band=(2000, 4000))   # cannot follow
+    ax_e, ax_s, _, _ = plot_diagnosis(rec.select("acc"), fixed)
+    assert any("no tachometer" in t.get_text() for t in ax_s.texts) and ax_e.get_xlabel() == "frequency [Hz]"
 
 
 def test_cli_diagnose_with_a_tachometer(tmp_path):
@@ -376,5 +381,5 @@ def test_cwru_records_run_at_a_steady_speed(shared_data):
     from vibmeasure.monitor.machinery import DRIFT_P, SPEED_DRIFT, _speed_drift
     for key in ("IR", "OR", "B"):
         rec = cwru(shared_data, key)
-        lo, hi, spread, p = _speed_drift(rec.data[0], rec.fs, rec.meta["rpm"] / 60)
+        lo, hi, spread, p, _ = _speed_drift(rec.data[0], rec.fs, rec.meta["rpm"] / 60)
         assert spread < SPEED_DRIFT / 2 and p > 10 * DRIFT_P

@@ -386,7 +386,8 @@ def plot_diagnosis(rec, diag, *, axes=None):
         ax_s.text(0.5, 0.9, "WARNING: the speed check failed (see the diagnosis flags)", transform=ax_s.transAxes,
                   ha="center", color="C3", fontsize=9, fontweight="bold")
     elif "order_tracked" in diag.flags or "speed_varies" in diag.flags:
-        msg = ("the speed varies over the record: lines smear in this spectrum (the diagnosis ran in orders)"
+        est = " (speed estimated from the 1X)" if diag.speed.get("source") == "1X line" else ""
+        msg = (f"the speed varies over the record: lines smear in this spectrum (the diagnosis ran in orders{est})"
                if "order_tracked" in diag.flags else
                "WARNING: the speed varies over the record and no tachometer was given: lines smear")
         ax_s.text(0.5, 0.9, msg, transform=ax_s.transAxes, ha="center", fontsize=8,

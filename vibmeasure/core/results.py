@@ -33,8 +33,9 @@ FLAG_TEXT = {
     "bearing_not_checked": "no bearing given: bearing faults were not searched",
     "band_limited": "a channel measures only up to a filter's edge, too low to demodulate above the shaft "
                     "harmonics: the bearing evidence is weak",
-    "speed_varies": "the 1X line moves over the record: shaft orders and bearing lines smear, and no "
-                    "shaft-order fault is called",
+    "speed_varies": "the 1X line moves over the record and the speed was not measured: where the 1X follows "
+                    "a curve the speed is estimated from it and the record analysed in orders; else the lines "
+                    "smear and no shaft-order fault is called",
     "order_tracked": "the speed varies: the record was resampled at equal steps of shaft angle and analysed in "
                      "orders",
 }

@@ -227,13 +227,39 @@ def _speed(job: _Job, f, A):
     if speed["consistent"]:
         drift = _speed_drift(job.a, job.fs, f1)
         if drift is not None and drift[2] > SPEED_DRIFT and drift[3] < DRIFT_P:
-            lo, hi, spread, _ = drift
-            speed.update(drift_hz=(lo, hi), note=(
+            lo, hi, spread, _, coef = drift
+            speed.update(drift_hz=(lo, hi), _curve=coef, note=(
                 f"the 1X line moves between {lo:.2f} and {hi:.2f} Hz over the record ({100 * spread:.1f} %): the "
                 "speed varies and the bearing lines smear; give tach= or rpm_profile= for an analysis in orders"))
             job.flags.append("speed_varies")
             job.bearing_weak = True
     return speed, f1
+
+
+def _speed_from_1x(rec, job: _Job, speed: dict, band):
+    """When the 1X drifts along a curve: that curve as the speed profile, the job order-tracked with
+    it, and the speed dict updated (source "1X line"); None when the curve is not a usable profile
+    (it leaves the range the 1X was seen in by more than half, or a band in Hz was fixed)."""
+    coef = speed.pop("_curve", None)
+    if coef is None or band is not None:
+        return None
+    t = np.arange(job.a.size) / job.fs
+    prof = 60.0 * np.polyval(coef, t)
+    lo, hi = speed["drift_hz"]
+    if not (prof.min() > 30.0 * lo and prof.max() < 90.0 * hi):
+        return None
+    est = _measured_speed(rec, None, prof, 1)
+    est["source"] = "1X line"
+    tracked, _ = _order_tracked_job(job, job.a.size, est, None)
+    if "order_tracked" not in tracked.flags:
+        return None
+    note = (f"the 1X line moves between {lo:.2f} and {hi:.2f} Hz over the record: the speed was estimated from "
+            f"it (a quadratic in time, {est['min_rpm']:.0f}-{est['max_rpm']:.0f} rpm) and the shaft orders and "
+            f"bearing lines analysed after angular resampling; frequencies are orders x the mean speed "
+            f"{est['mean_rpm'] / 60:.2f} Hz. A tachometer (tach=) measures the speed instead of estimating it")
+    speed.update(estimated_rpm=est["mean_rpm"], min_rpm=est["min_rpm"], max_rpm=est["max_rpm"], source="1X line",
+                 note=note)
+    return tracked
 
 
 SPEED_DRIFT = 0.02   # the 1X line may wander this much (share of its mean) before the speed is said to vary
@@ -246,12 +272,13 @@ DRIFT_P = 1e-3       # ... along a curve that a constant speed would follow by c
 
 
 def _speed_drift(a, fs, f1, n_seg=8):
-    """(lowest, highest, spread, p) of the 1X line's frequency over n_seg parts of the record, from
+    """(lowest, highest, spread, p, curve) of the 1X line's frequency over n_seg parts of the record, from
     the parts where it stands LINE_DB above its floor (at least 6 of them; else None). lowest and
     highest are those of a quadratic in time fitted to the parts' 1X (a run-up, a run-down, or both),
     spread their difference over the mean; p is the F-test's probability that a constant speed
     scatters as far from a constant as it does from the curve: a marginal 1X wanders from part to part
-    by noise alone, a speed that changes follows the curve."""
+    by noise alone, a speed that changes follows the curve. curve: the quadratic's coefficients for
+    the 1X in Hz against time in seconds (np.polyval)."""
     n_seg = min(n_seg, int(a.size / fs * f1 / 8))     # each part spans 8 revolutions or more
     if n_seg < 4:
         return None
@@ -263,7 +290,7 @@ def _speed_drift(a, fs, f1, n_seg=8):
         return None
     A = np.abs(np.fft.rfft(a[: n_seg * L].reshape(n_seg, L) * w, axis=1))
     found, when = [], []
-    for j, row in enumerate(A):
+    for j, row in enumerate(A):   # when: the part's middle, in parts
         k = sel[np.argmax(row[sel])]
         ring = (np.abs(f - f[k]) < max(0.25 * f1, 12 * f[1])) & (np.abs(f - f[k]) > 3 * f[1])
         if ring.sum() < 5 or 20 * np.log10(row[k] / max(np.median(row[ring]), 1e-300)) < LINE_DB:
@@ -281,7 +308,10 @@ def _speed_drift(a, fs, f1, n_seg=8):
     rss0 = float(np.sum((found - mean) ** 2))
     dof = found.size - 3
     F = (rss0 - rss2) / 2 / max(rss2 / dof, 1e-30 * mean ** 2)
-    return float(curve.min()), float(curve.max()), float(curve.max() - curve.min()) / mean, float(fdtrc(2, dof, F))
+    # the same curve with time in seconds (a part lasts L / fs)
+    coef_s = coef * np.array([(fs / L) ** 2, fs / L, 1.0])
+    return (float(curve.min()), float(curve.max()), float(curve.max() - curve.min()) / mean, float(fdtrc(2, dof, F)),
+            coef_s)
 
 
 VARYING_SPEED = 0.002   # above this spread of the mean speeds of the record's parts, the analysis runs in orders
@@ -543,6 +573,13 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         job, note = _order_tracked_job(job, rec.n_samples, tracked, band)
     f, A, V = _spectrum(job)
     speed, f1 = _speed(job, f, A) if tracked is None else _tach_speed(job, f, A, tracked, rpm, note)
+    if "speed_varies" in job.flags:   # no speed information, but the 1X drifts along a curve: follow it
+        tracked_1x = _speed_from_1x(rec, job, speed, band)
+        if tracked_1x is not None:
+            job = tracked_1x
+            f, A, V = _spectrum(job)
+            f1 = speed["estimated_rpm"] / 60.0
+    speed.pop("_curve", None)
     severity, level = _severity(measured, np.fft.rfftfreq(measured.a.size, 1 / measured.fs), measured.rpm)
     v_rms = severity["velocity_rms_mm_s"] if severity["velocity_rms_mm_s"] is not None else np.nan
     rows, order = sf.shaft_order_rows(f, V, f1, v_rms, level, job.flags, _line, _row, LINE_DB)
@@ -557,7 +594,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         job.bearing_weak = len(narrow) == len(ev["measured_top_hz"])
     if job.gear is not None:
         rows.append(sf.gear_row(f, A, f1, job.gear, _line, _row, LINE_DB))
-    if "speed_varies" in job.flags:   # 1X and its orders are smeared over the record: nothing to weigh
+    if "speed_varies" in job.flags and "order_tracked" not in job.flags:   # smeared orders: nothing to weigh
         for r in rows:
             if r["fault"] in SHAFT_FAULTS and r["confidence"] > 0:
                 r["note"] = "not called, the speed varies over the record: " + r["note"]
