@@ -572,10 +572,12 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     A speed that varies over the record: give ``tach`` (the tachometer or encoder channel, by name or
     index, or its samples; ``pulses_per_rev`` pulses per revolution) or ``rpm_profile`` (one rpm per
     sample). ``rpm`` then defaults to the mean speed. When the mean speeds of up to 8 parts of the
-    record differ by more than ``VARYING_SPEED`` (0.2 %), every channel is resampled at equal steps of shaft angle and the
-    shaft-order and bearing analyses run in orders (cepstral pre-whitening after order tracking:
-    Borghesani et al. 2013); frequencies are then given as orders x the mean speed, flag
-    ``order_tracked``. The ISO severity is taken from the record as measured.
+    record differ by more than ``VARYING_SPEED`` (0.2 %), every channel is resampled at equal steps
+    of shaft angle and the shaft-order and bearing analyses run in orders (cepstral pre-whitening
+    after order tracking: Borghesani et al. 2013); frequencies are then orders x the mean speed, flag
+    ``order_tracked``. Without speed information, a 1X that drifts along a curve (flag
+    ``speed_varies``) gives the speed profile instead (``speed["source"]`` "1X line"). The ISO
+    severity is taken from the record as measured.
     """
     from . import shaft_faults as sf
     rec = as_record(rec, fs=fs)
