@@ -324,6 +324,8 @@ def test_a_steady_machine_with_a_tachometer_keeps_the_analysis_as_measured():
     assert d.speed["estimated_rpm"] == pytest.approx(1797.0, rel=1e-4)   # pulses timed to a fraction of a sample
     assert d.channel == "acc"                                           # the tachometer is not searched
     assert list(d.extras["measured_top_hz"]) == ["acc"]
+    by_index = vm.diagnose(rec, tach=np.int64(1), pulses_per_rev=2, bearing="6205-2RS")   # by index, as well
+    assert by_index.top == d.top and list(by_index.extras["measured_top_hz"]) == ["acc"]
 
 
 def test_speed_information_bad_input():

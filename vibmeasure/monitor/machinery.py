@@ -586,7 +586,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         tracked = _measured_speed(rec, tach, rpm_profile, pulses_per_rev)
         if rpm is None:
             rpm = tracked["mean_rpm"]
-    skip = (rec.index(tach),) if isinstance(tach, (str, int)) and not isinstance(tach, bool) else ()
+    skip = (rec.index(tach),) if isinstance(tach, (str, int, np.integer)) and not isinstance(tach, bool) else ()
     job = _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band, skip)
     job.prewhitening = _check_prewhitening(prewhitening)
     measured = job
