@@ -128,7 +128,7 @@ def _shaft_angle(rec, *, tach=None, rpm_profile=None, pulses_per_rev: int = 1, t
     if (tach is None) == (rpm_profile is None):
         raise ParameterError("give exactly one of tach (pulse channel name or array) and rpm_profile")
     if tach is not None:
-        p = rec.channel(tach) if isinstance(tach, (str, int)) else np.asarray(tach, float)
+        p = rec.channel(tach) if isinstance(tach, (str, int, np.integer)) else np.asarray(tach, float)
         if p.shape != t.shape:
             raise ParameterError(f"tach has {p.size} samples; the record has {t.size}")
         lvl = (p.max() + p.min()) / 2 if tach_level is None else tach_level
