@@ -344,6 +344,12 @@ def test_speed_information_bad_input():
         vm.diagnose(flat, tach="tach", rpm=1800)
     with pytest.raises(vm.ParameterError, match="band= is in Hz"):
         vm.diagnose(rec, tach="tach", bearing="6205-2RS", band=(2000, 4000))
+    nan_tach = rec.data.copy()
+    nan_tach[1, 50] = np.inf
+    with pytest.raises(vm.ParameterError, match="tach has 1 NaN/inf samples"):
+        vm.diagnose(vm.Record(nan_tach, rec.fs, rec.channels), tach="tach", bearing="6205-2RS")
+    with pytest.raises(vm.ParameterError, match="tach has 0 samples"):
+        vm.diagnose(vm.Record(np.zeros((2, 0)), rec.fs, rec.channels), tach="tach", bearing="6205-2RS")
     with pytest.raises(vm.ParameterError, match="only channels"):
         vm.diagnose(vm.Record(rec.data[1:], rec.fs, [vm.Channel("tach", "unknown", "V")]), tach="tach")
 

@@ -46,6 +46,13 @@ def test_order_tracking_bad_input():
         vm.order_track(rec, channel="acc", rpm_profile=-rpm)
     with pytest.raises(vm.ParameterError, match="pulse"):
         vm.order_track(rec, channel="acc", tach=np.zeros(rec.n_samples))
+    bad = rec.channel("tach").copy()
+    bad[7] = np.nan
+    with pytest.raises(vm.ParameterError, match="tach has 1 NaN/inf samples .first at index 7.; the rule is finite"):
+        vm.order_track(rec, channel="acc", tach=bad)
+    empty = vm.Record(np.zeros((2, 0)), fs=rec.fs, channels=rec.channels)
+    with pytest.raises(vm.ParameterError, match="tach has 0 samples; pulses need at least 4"):
+        vm.order_track(empty, channel="acc", tach="tach")
 
 
 def test_a_slow_noisy_keyphasor_gives_one_pulse_per_revolution():

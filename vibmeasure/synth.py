@@ -308,7 +308,7 @@ def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: f
 
     def at_angle(revs):
         """Times at which the shaft reaches the given angles (revolutions)."""
-        return np.interp(revs, theta, t, right=np.inf) if ramp else np.asarray(revs) / f1
+        return np.interp(revs, theta, t) if ramp else np.asarray(revs) / f1
     b = bearing if isinstance(bearing, Bearing) else BEARINGS["6205-2RS"] if bearing is None else BEARINGS[bearing]
     base = 0.02 * np.sin(shaft_phase(1) + rng.uniform(0, 2 * np.pi))  # residual unbalance, healthy level
     sig = np.zeros(n)

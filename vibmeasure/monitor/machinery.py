@@ -266,7 +266,7 @@ def _speed_from_1x(rec, job: _Job, speed: dict, band):
         return None
     est = _measured_speed(rec, None, prof, 1)
     est["source"] = "1X line"
-    tracked, _ = _order_tracked_job(job, job.a.size, est, None)
+    tracked, _ = _order_tracked_job(job, est, None)
     if "order_tracked" not in tracked.flags:
         return None
     note = (f"the 1X line moves between {lo:.2f} and {hi:.2f} Hz over the record: the speed was estimated from "
@@ -364,13 +364,13 @@ def _measured_speed(rec, tach, rpm_profile, pulses_per_rev) -> dict:
     edges = np.linspace(0, revs.size - 1, n_p + 1).round().astype(int)
     parts = 60.0 * np.diff(revs[edges]) / np.diff(t_rev[edges])
     mean = 60.0 * float((ang[ok[-1]] - ang[ok[0]]) / (t[ok[-1]] - t[ok[0]]))
-    return {"angle": ang, "valid": (int(ok[0]), int(ok[-1]) + 1), "mean_rpm": mean,
+    return {"angle": ang, "mean_rpm": mean,
             "min_rpm": float(per_rev.min()), "max_rpm": float(per_rev.max()),
             "spread": float(parts.max() - parts.min()) / mean,
             "source": "tachometer" if tach is not None else "rpm profile"}
 
 
-def _order_tracked_job(job: _Job, n: int, tracked: dict, band):
+def _order_tracked_job(job: _Job, tracked: dict, band):
     """The job with every channel resampled at equal steps of shaft angle when the speed varies: its
     'fs' is the angular rate at the mean speed (samples per revolution x mean revolutions per second),
     so every Hz below is an order x the mean speed. A constant speed keeps the record as measured."""
@@ -381,15 +381,11 @@ def _order_tracked_job(job: _Job, n: int, tracked: dict, band):
     if band is not None:
         raise ParameterError("band= is in Hz, but this record's speed varies and the bands are searched in orders "
                              "after angular resampling: leave band unset")
-    from scipy.interpolate import CubicSpline
-    ang = tracked["angle"]
-    i0, i1 = tracked["valid"]
-    t = np.arange(n) / job.fs
+    from ..signal.demod import _angle_grid, _at_times
     spr = job.fs / (tracked["min_rpm"] / 60.0)          # the slowest speed's whole band is kept
-    grid = np.arange(np.ceil(ang[i0] * spr), np.floor(ang[i1 - 1] * spr)) / spr
-    grid = grid[:_fast_len_below(grid.size)]   # a length with small prime factors: the FFTs stay fast
-    t_grid = np.interp(grid, ang[i0:i1], t[i0:i1])
-    signals = {k: CubicSpline(t, x)(t_grid) for k, x in job.signals.items()}
+    _, t_grid = _angle_grid(tracked["angle"], job.fs, spr)
+    t_grid = t_grid[:_fast_len_below(t_grid.size)]   # a length with small prime factors: the FFTs stay fast
+    signals = {k: _at_times(x, job.fs, t_grid) for k, x in job.signals.items()}
     note = (f"speed {tracked['min_rpm']:.0f}-{tracked['max_rpm']:.0f} rpm (from the {tracked['source']}): shaft "
             f"orders and bearing lines analysed after angular resampling; frequencies are orders x the mean "
             f"speed {f_mean:.2f} Hz")
@@ -591,7 +587,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     job.prewhitening = _check_prewhitening(prewhitening)
     measured = job
     if tracked is not None:
-        job, note = _order_tracked_job(job, rec.n_samples, tracked, band)
+        job, note = _order_tracked_job(job, tracked, band)
     f, A, V = _spectrum(job)
     speed, f1 = _speed(job, f, A) if tracked is None else _tach_speed(job, f, A, tracked, rpm, note)
     if "speed_varies" in job.flags:   # no speed information, but the 1X drifts along a curve: follow it

@@ -131,6 +131,12 @@ def _shaft_angle(rec, *, tach=None, rpm_profile=None, pulses_per_rev: int = 1, t
         p = rec.channel(tach) if isinstance(tach, (str, int, np.integer)) else np.asarray(tach, float)
         if p.shape != t.shape:
             raise ParameterError(f"tach has {p.size} samples; the record has {t.size}")
+        if p.size < 4:
+            raise ParameterError(f"tach has {p.size} samples; pulses need at least 4")
+        bad = np.flatnonzero(~np.isfinite(p))
+        if bad.size:
+            raise ParameterError(f"tach has {bad.size} NaN/inf samples (first at index {bad[0]}); the rule is finite "
+                                 "data: repair or cut the record first")
         lvl = (p.max() + p.min()) / 2 if tach_level is None else tach_level
         up = _rising_edges(p, lvl, 0.1 * (p.max() - p.min()))
         if up.size < 3:
@@ -146,6 +152,21 @@ def _shaft_angle(rec, *, tach=None, rpm_profile=None, pulses_per_rev: int = 1, t
     return cumulative_trapezoid(prof / 60.0, t, initial=0.0)
 
 
+def _angle_grid(ang, fs, samples_per_rev):
+    """Equal steps of shaft angle (revolutions) over the samples where the angle is known, and the
+    times at which the shaft reaches them."""
+    ok = np.flatnonzero(np.isfinite(ang))
+    a0, a1 = ang[ok[0]], ang[ok[-1]]
+    grid = np.arange(np.ceil(a0 * samples_per_rev), np.floor(a1 * samples_per_rev)) / samples_per_rev
+    return grid, np.interp(grid, ang[ok], ok / fs)
+
+
+def _at_times(x, fs, t_grid):
+    """Samples x (at rate fs) interpolated at the given times (cubic spline)."""
+    from scipy.interpolate import CubicSpline
+    return CubicSpline(np.arange(x.size) / fs, x)(t_grid)
+
+
 def order_track(rec, *, channel=None, tach=None, rpm_profile=None, samples_per_rev: int = 64,
                 pulses_per_rev: int = 1, fs: float | None = None) -> Record:
     """Angular resampling: the channel at equal shaft-angle steps (``samples_per_rev`` per
@@ -156,15 +177,10 @@ def order_track(rec, *, channel=None, tach=None, rpm_profile=None, samples_per_r
     if isinstance(samples_per_rev, bool) or not isinstance(samples_per_rev, (int, np.integer)) or samples_per_rev < 4:
         raise ParameterError(f"samples_per_rev={samples_per_rev!r} must be an integer >= 4")
     ang = _shaft_angle(rec, tach=tach, rpm_profile=rpm_profile, pulses_per_rev=pulses_per_rev)
-    ok = np.isfinite(ang)
-    a0, a1 = ang[ok][0], ang[ok][-1]
-    grid = np.arange(np.ceil(a0 * samples_per_rev), np.floor(a1 * samples_per_rev)) / samples_per_rev
+    grid, t_grid = _angle_grid(ang, rec.fs, samples_per_rev)
     if grid.size < 4 * samples_per_rev:
         raise ParameterError("fewer than 4 revolutions are covered by the speed information")
-    t = np.arange(rec.n_samples) / rec.fs
-    t_grid = np.interp(grid, ang[ok], t[ok])
-    from scipy.interpolate import CubicSpline
-    x = CubicSpline(t, rec.data[i])(t_grid)
+    x = _at_times(rec.data[i], rec.fs, t_grid)
     c = rec.channels[i]
     return Record(x, float(samples_per_rev), (Channel(f"{c.name}.orders", c.quantity, c.unit, c.location),),
                   meta=dict(rec.meta, domain="angle", samples_per_rev=samples_per_rev, first_rev=float(grid[0])),
