@@ -86,11 +86,11 @@ def test_without_a_bearing_a_none_is_weak_evidence_of_health():
     assert blind.top == seen.top == "none"
     assert 0.1 < blind.confidence < 0.4 and seen.confidence > 0.95
     assert "bearing faults not checked" in blind.reason
-    # this machine shows a marginal BPFO comb (p ~ 0.001, not called): the bearing part of its "none"
-    # score is 0.64, as low as a buried resonance's whole score, yet a "none" with its shaft-order part
-    # near 1 was right in every calibration machine: calibrated apart, the parts keep it confident
+    # this machine shows a weak BPFO comb (not called): the bearing part of its "none" score is 0.89
+    # (0.64 before the floor ratio followed the exact law of its median), yet a "none" with its
+    # shaft-order part near 1 is nearly always right: calibrated apart, the parts keep it confident
     parts = seen.extras["score_parts"]
-    assert parts["shaft"] > 0.95 and parts["bearing"] < 0.7
+    assert parts["shaft"] > 0.95 and parts["bearing"] < 0.95
 
 
 def test_report_flags_an_unlikely_none_for_a_look():
