@@ -250,6 +250,60 @@ def test_lvm_truncated_header(tmp_path):
 
 
 # --- dispatch and writing ---------------------------------------------------------------------
+def test_mat_struct_arrays_by_element_name_or_index(tmp_path):
+    # the Paderborn rig's files hold struct arrays Y(1..7) with fields Name and Data, at several rates:
+    # each element's fields are reached by its Name (Y.vibration_1.Data); without distinct names, by
+    # its 1-based index (S(2).Data). With no channel named, the dominant length is taken
+    import scipy.io as sio
+    rng = np.random.default_rng(5)
+    dt = [("Name", "O"), ("Raster", "O"), ("Data", "O")]
+    Y = np.zeros((1, 4), dtype=dt)
+    for i, (name, n) in enumerate([("phase_current_1", 640), ("phase_current_2", 640), ("vibration_1", 640),
+                                   ("temp_2_bearing_module", 1)]):
+        Y[0, i] = (name, "HostService", rng.normal(size=(1, n)))
+    S = np.zeros((1, 2), dtype=[("Name", "O"), ("Data", "O")])
+    S[0, 0], S[0, 1] = ("a", rng.normal(size=(1, 64))), ("a", rng.normal(size=(1, 64)))   # names not distinct
+    top = np.zeros((1, 1), dtype=[("Info", "O"), ("Y", "O"), ("S", "O")])
+    top[0, 0] = ("", Y, S)
+    f = tmp_path / "N15_M07_F10_K001_1.mat"
+    sio.savemat(f, {"N15": top})
+    rec = vm.read(f, fs=64000)
+    assert rec.names == ["N15.Y.phase_current_1.Data", "N15.Y.phase_current_2.Data", "N15.Y.vibration_1.Data"]
+    vib = vm.read(f, fs=64000, channels=["N15.Y.vibration_1.Data"])
+    np.testing.assert_array_equal(vib.data[0], Y[0, 2]["Data"].ravel())
+    np.testing.assert_array_equal(vm.read(f, fs=1000, channels="N15.S(2).Data").data[0], S[0, 1]["Data"].ravel())
+
+
+def test_a_file_named_by_its_time_stamp_is_read_by_its_content(tmp_path):
+    # the IMS rig names its files by time stamp (2004.02.12.10.32.39: the "ending" is .39) and writes
+    # tab-separated columns without a header: the content decides the format
+    rng = np.random.default_rng(3)
+    x = np.round(rng.normal(size=(2048, 4)), 3)
+    ims = tmp_path / "2004.02.12.10.32.39"
+    np.savetxt(ims, x, fmt="%.3f", delimiter="\t")
+    rec = vm.read(ims, fs=20480)
+    assert rec.data.shape == (4, 2048) and rec.fs == 20480
+    np.testing.assert_allclose(rec.data, x.T, atol=5e-4)   # 3 decimals written
+    # binary formats by their signatures, whatever the name
+    src = vm.Record.from_array(x.T, fs=1000.0, unit="g")
+    for ending in (".h5", ".wav"):
+        f = vm.write(tmp_path / f"r{ending}", src)
+        bare = tmp_path / f"bare{ending.replace('.', '_')}.dat"
+        bare.write_bytes(f.read_bytes())
+        back = vm.read(bare)
+        assert back.data.shape == (4, 2048)
+    import scipy.io as sio
+    sio.savemat(tmp_path / "m.mat", {"acc": x[:, 0], "fs": 1000.0})
+    (tmp_path / "m.dat").write_bytes((tmp_path / "m.mat").read_bytes())
+    np.testing.assert_allclose(vm.read(tmp_path / "m.dat", channels=["acc"]).data[0], x[:, 0])
+    # neither a known signature nor delimited numbers: a clear error naming the readable formats
+    (tmp_path / "junk.bin").write_bytes(bytes(range(256)) * 8)
+    (tmp_path / "words.log").write_text("pump 3 started\nno data here\nend\n")
+    for bad in ("junk.bin", "words.log"):
+        with pytest.raises(vm.ParameterError, match="unknown file type .* none of the readable formats"):
+            vm.read(tmp_path / bad)
+
+
 def test_unknown_missing_empty(tmp_path):
     with pytest.raises(vm.ParameterError, match="does not exist"):
         vm.read(tmp_path / "nope.csv")

@@ -1,8 +1,10 @@
-"""Files in and out: ``read`` and ``write`` choose the format by the file's ending."""
+"""Files in and out: ``read`` and ``write`` choose the format by the file's ending (``read``, when the
+ending names no format, by the file's content)."""
 
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 from ..core.errors import ParameterError, UnitError
@@ -29,7 +31,9 @@ def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, qua
          allow_external: bool = False) -> Record:
     """Read a measurement file into a :class:`Record`.
 
-    The format follows the ending: .csv/.txt/.tsv, .h5/.hdf5, .wav, .mat (v5 and v7.3), .lvm.
+    The format follows the ending: .csv/.txt/.tsv, .h5/.hdf5, .wav, .mat (v5 and v7.3), .lvm, .uff/.unv;
+    a file whose ending names none of them (the IMS rig's 2004.02.12.10.32.39) is recognised by its
+    content (signature, or lines of delimited numbers).
     ``fs`` is required when the file holds no timing information and must agree with it
     otherwise. ``channels`` selects columns/variables by name (dotted paths for MATLAB structs,
     ``"name[i]"`` for one row of a matrix) or position; ``quantity`` and ``unit`` label the data
@@ -47,16 +51,50 @@ def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, qua
     if p.is_dir():
         raise ParameterError(f"path={str(path)!r} is a folder, not a file")
     ext = p.suffix.lower()
-    if ext not in _READERS:
-        raise ParameterError(f"path={str(path)!r}: unknown file type {ext!r}; readable: {FORMATS}")
     if p.stat().st_size == 0:
         raise ParameterError(f"path={str(path)!r} is empty (0 bytes)")
+    if ext not in _READERS:
+        ext = _sniff(p)
+        if ext is None:
+            raise ParameterError(f"path={str(path)!r}: unknown file type {p.suffix.lower()!r} and its content is "
+                                 f"none of the readable formats {FORMATS}")
     kw = dict(fs=fs, channels=channels, quantity=quantity, unit=unit, max_samples=check_max_samples(max_samples))
     if ext in (".h5", ".hdf5"):
         kw.update(dataset=dataset, allow_external=bool(allow_external))
     elif dataset is not None:
         raise ParameterError(f"dataset={dataset!r} applies to HDF5 files only, not {ext!r}")
     return guarded(_READERS[ext], p, **kw)
+
+
+def _sniff(p: Path) -> str | None:
+    """The format of a file whose name does not say it (the IMS rig's files are named by their time
+    stamp, 2004.02.12.10.32.39), from its first bytes: HDF5 (also MATLAB v7.3), MATLAB v5, WAV, LabVIEW
+    text, Universal File Format, or delimited numbers as text."""
+    with open(p, "rb") as fh:
+        head = fh.read(4096)
+    if head.startswith(b"MATLAB"):         # v5, and v7.3 (an HDF5 file behind a 512-byte MATLAB header)
+        return ".mat"
+    if any(head[k: k + 8] == b"\x89HDF\r\n\x1a\n" for k in (0, 512, 1024, 2048)):   # after a user block
+        return ".h5"
+    if head[:4] == b"RIFF" and head[8:12] == b"WAVE":
+        return ".wav"
+    if b"\x00" in head:
+        return None
+    text = head.decode("latin-1")
+    if text.startswith("LabVIEW Measurement"):
+        return ".lvm"
+    lines = [ln for ln in text.splitlines()[:-1] if ln.strip()]   # the last may be cut by the 4 kB read
+    if lines and lines[0].strip() == "-1" and any(ln.strip() in _UFF_SETS for ln in lines[1:3]):
+        return ".uff"
+    body = lines[1:] if lines and not _NUMBERS.match(lines[0]) else lines   # a header line is allowed
+    if len(body) >= 2 and all(_NUMBERS.match(ln) for ln in body):
+        return ".csv"
+    return None
+
+
+_UFF_SETS = ("58", "58b", "55", "151", "164")   # dataset numbers a Universal File opens with
+_NUMBER = r"[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?"
+_NUMBERS = re.compile(rf"^[\s,;]*{_NUMBER}([\s,;]+{_NUMBER})*[\s,;]*$")   # a line of delimited numbers
 
 
 def guarded(reader, path, **kw):

@@ -1,7 +1,8 @@
 """MATLAB .mat files: v4/v5 through scipy.io, v7.3 (HDF5) through h5py.
 
 Variables and nested struct fields are addressed by dotted paths (``"bearing.gs"``,
-``"Fe.Out.Acc"``); a matrix variable gives one channel per row (``"Fe.Out.Acc[0]"``). The
+``"Fe.Out.Acc"``); a matrix variable gives one channel per row (``"Fe.Out.Acc[0]"``); the elements
+of a struct array by their Name field (``"N15.Y.vibration_1.Data"``) or 1-based index (``"S(2).Data"``). The
 sampling rate comes from ``fs``, a sample-rate variable in the file, or a time vector.
 """
 
@@ -40,6 +41,10 @@ def _leaves_v5(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
             if v.size == 1:
                 for fld in v.dtype.names:
                     walk(f"{prefix}.{fld}", v[fld].flat[0])
+            else:   # a struct array (the Paderborn rig's Y(1..7)): its elements by name, else by index
+                for label, el in zip(_element_labels(v), v.flat):
+                    for fld in v.dtype.names:
+                        walk(f"{prefix}{label}.{fld}", el[fld])
         elif isinstance(v, np.ndarray) and v.dtype == object:
             if v.size == 1:
                 walk(prefix, v.flat[0])
@@ -49,6 +54,25 @@ def _leaves_v5(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
         if not k.startswith("__"):
             walk(k, v)
     return out
+
+
+def _element_labels(v: np.ndarray) -> list[str]:
+    """Path parts of a struct array's elements: ".name" from a text field Name (or name) when every
+    element has a distinct one that is a plain identifier, else "(i)", 1-based as in MATLAB."""
+    fld = next((f for f in ("Name", "name") if f in v.dtype.names), None)
+    names = [_text(el[fld]) for el in v.flat] if fld else []
+    if fld and len(set(names)) == v.size and all(n and re.fullmatch(r"[A-Za-z_]\w*", n) for n in names):
+        return [f".{n}" for n in names]
+    return [f"({i + 1})" for i in range(v.size)]
+
+
+def _text(x) -> str | None:
+    """A MATLAB char value as loaded by scipy (possibly wrapped in 1x1 object arrays), else None."""
+    while isinstance(x, np.ndarray) and x.dtype == object and x.size == 1:
+        x = x.flat[0]
+    if isinstance(x, np.ndarray) and x.dtype.kind == "U" and x.size == 1:
+        x = str(x.flat[0])
+    return x.strip() if isinstance(x, str) else None
 
 
 class _V73(Exception):
