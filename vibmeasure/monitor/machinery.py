@@ -496,7 +496,10 @@ def _decide(table, job: _Job):
     checked = "" if job.bearing is not None else "; bearing faults not checked (no bearing given)"
     if len(calls):
         best = calls.iloc[0]
-        kin = [r for _, r in calls.iloc[1:].iterrows() if (r.fault in FAMILIES) == (best.fault in FAMILIES)]
+        # a rival of the same kind close behind (even under TOP_CONFIDENCE: two bearing families that
+        # split the spectra's votes near half and half) makes the answer a tie
+        rivals = ranked[(ranked.fault != best.fault) & (ranked.fault != "bearing_cage")]
+        kin = [r for _, r in rivals.iterrows() if (r.fault in FAMILIES) == (best.fault in FAMILIES)]
         if not kin or best.confidence - kin[0].confidence >= 0.15:
             top, score = str(best.fault), float(best.confidence)
             kind = "bearing" if top in FAMILIES else "shaft"
