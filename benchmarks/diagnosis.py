@@ -41,6 +41,8 @@ STRESS = [  # (label, synth.machine keywords, bearing, answers that are acceptab
      "6203-2RS", {"none", "looseness"}),
     ("healthy, strong shaft-rate impacts", dict(fault="none", shaft_impacts=3.0, bearing="6203-2RS"), "6203-2RS",
      {"none", "looseness"}),
+    ("healthy, shaft-rate impacts (6205-2RS)", dict(fault="none", shaft_impacts=0.5), "6205-2RS",
+     {"none", "looseness"}),
 ]
 
 

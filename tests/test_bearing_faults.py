@@ -173,8 +173,9 @@ def test_fault_line_on_a_shaft_order_in_a_short_record(bearing, fault):
     (dict(fault="bearing_outer_race", cage_modulation=1.0), "6205-2RS", {"bearing_outer_race"}),
     (dict(fault="none", shaft_impacts=1.0, bearing="6203-2RS"), "6203-2RS", {"none", "looseness"}),
     (dict(fault="none", shaft_impacts=3.0, bearing="6203-2RS"), "6203-2RS", {"none", "looseness"}),
+    (dict(fault="none", shaft_impacts=0.5), "6205-2RS", {"none", "looseness"}),
 ], ids=["cage-modulation-is-no-fault", "outer-race-beside-cage-comb", "shaft-harmonics-near-2xBSF",
-        "strong-shaft-impacts"])
+        "strong-shaft-impacts", "shaft-impacts-6205"])
 def test_stress_cases(kw, bearing, ok):
     # the cage comb is claimed (reported, not called); shaft harmonics are claimed before any bearing
     # family, so 4X (2xBSF of the 6203 is 3.99X) is never ball evidence
