@@ -296,6 +296,13 @@ def test_a_file_named_by_its_time_stamp_is_read_by_its_content(tmp_path):
     sio.savemat(tmp_path / "m.mat", {"acc": x[:, 0], "fs": 1000.0})
     (tmp_path / "m.dat").write_bytes((tmp_path / "m.mat").read_bytes())
     np.testing.assert_allclose(vm.read(tmp_path / "m.dat", channels=["acc"]).data[0], x[:, 0])
+    # damaged content under such a name keeps its named errors: a NaN row, a cut HDF5 file
+    (tmp_path / "2004.02.12.10.42.39").write_text("1.0\t2.0\nnan\t3.0\n4\t5\n")
+    with pytest.raises(vm.ParameterError, match="row 2 has missing values"):
+        vm.read(tmp_path / "2004.02.12.10.42.39", fs=100)
+    (tmp_path / "cut.39").write_bytes((tmp_path / "r.h5").read_bytes()[:1500])
+    with pytest.raises(vm.ParameterError, match="damaged|truncated|not a valid"):
+        vm.read(tmp_path / "cut.39")
     # neither a known signature nor delimited numbers: a clear error naming the readable formats
     (tmp_path / "junk.bin").write_bytes(bytes(range(256)) * 8)
     (tmp_path / "words.log").write_text("pump 3 started\nno data here\nend\n")

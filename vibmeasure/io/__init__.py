@@ -63,7 +63,7 @@ def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, qua
         kw.update(dataset=dataset, allow_external=bool(allow_external))
     elif dataset is not None:
         raise ParameterError(f"dataset={dataset!r} applies to HDF5 files only, not {ext!r}")
-    return guarded(_READERS[ext], p, **kw)
+    return guarded(_READERS[ext], p, kind=ext, **kw)
 
 
 def _sniff(p: Path) -> str | None:
@@ -93,11 +93,11 @@ def _sniff(p: Path) -> str | None:
 
 
 _UFF_SETS = ("58", "58b", "55", "151", "164")   # dataset numbers a Universal File opens with
-_NUMBER = r"[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?"
-_NUMBERS = re.compile(rf"^[\s,;]*{_NUMBER}([\s,;]+{_NUMBER})*[\s,;]*$")   # a line of delimited numbers
+_NUMBER = r"([-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?|[-+]?(nan|inf|infinity))"   # NaN: the reader names it
+_NUMBERS = re.compile(rf"^[\s,;]*{_NUMBER}([\s,;]+{_NUMBER})*[\s,;]*$", re.I)   # a line of delimited numbers
 
 
-def guarded(reader, path, **kw):
+def guarded(reader, path, kind=None, **kw):
     """Run a reader; any failure inside h5py, scipy.io, pyuff, pandas or numpy parsing becomes a
     ParameterError naming the file (a library's raw exception is never what the user sees)."""
     try:
@@ -109,7 +109,7 @@ def guarded(reader, path, **kw):
                              "(channels=...) or stream it with vm.open") from None
     except (ValueError, TypeError, KeyError, IndexError, ZeroDivisionError, UnboundLocalError, RecursionError,
             OSError, EOFError, AttributeError, OverflowError, UnicodeError, LookupError, RuntimeError) as exc:
-        raise ParameterError(f"path={str(path)!r} is damaged or not a valid {Path(path).suffix} file "
+        raise ParameterError(f"path={str(path)!r} is damaged or not a valid {kind or Path(path).suffix} file "
                              f"({type(exc).__name__}: {str(exc)[:200]})") from None
 
 
