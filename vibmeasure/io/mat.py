@@ -2,8 +2,9 @@
 
 Variables and nested struct fields are addressed by dotted paths (``"bearing.gs"``,
 ``"Fe.Out.Acc"``); a matrix variable gives one channel per row (``"Fe.Out.Acc[0]"``); the elements
-of a struct array by their Name field (``"N15.Y.vibration_1.Data"``) or 1-based index (``"S(2).Data"``). The
-sampling rate comes from ``fs``, a sample-rate variable in the file, or a time vector.
+of a struct array by their Name field (``"N15.Y.vibration_1.Data"``) or 1-based index
+(``"S(2).Data"``). The sampling rate comes from ``fs``, a sample-rate variable in the file, or a
+time vector.
 """
 
 from __future__ import annotations
