@@ -284,6 +284,9 @@ def test_a_file_named_by_its_time_stamp_is_read_by_its_content(tmp_path):
     rec = vm.read(ims, fs=20480)
     assert rec.data.shape == (4, 2048) and rec.fs == 20480
     np.testing.assert_allclose(rec.data, x.T, atol=5e-4)   # 3 decimals written
+    # a short file (under the 4 kB looked at) keeps its last line: two rows are enough
+    (tmp_path / "2004.02.12.10.52.39").write_text("0.5\t1.5\n-0.25\t2.0\n")
+    np.testing.assert_array_equal(vm.read(tmp_path / "2004.02.12.10.52.39", fs=10).data, [[0.5, -0.25], [1.5, 2.0]])
     # binary formats by their signatures, whatever the name
     src = vm.Record.from_array(x.T, fs=1000.0, unit="g")
     for ending in (".h5", ".wav"):

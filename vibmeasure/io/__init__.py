@@ -83,7 +83,10 @@ def _sniff(p: Path) -> str | None:
     text = head.decode("latin-1")
     if text.startswith("LabVIEW Measurement"):
         return ".lvm"
-    lines = [ln for ln in text.splitlines()[:-1] if ln.strip()]   # the last may be cut by the 4 kB read
+    lines = text.splitlines()
+    if len(head) == 4096:
+        lines = lines[:-1]   # the last may be cut by the 4 kB read
+    lines = [ln for ln in lines if ln.strip()]
     if lines and lines[0].strip() == "-1" and any(ln.strip() in _UFF_SETS for ln in lines[1:3]):
         return ".uff"
     body = lines[1:] if lines and not _NUMBERS.match(lines[0]) else lines   # a header line is allowed
