@@ -477,7 +477,7 @@ def _bearing_rows(job: _Job, f1: float, speed: dict):
         rows.append(_row(name, s["expected_hz"], s["found_hz"], s["amplitude"], s["evidence_db"], s["confidence"],
                          note, p_value=s["p_value"], log10_p=s["log10_p"], statistic=s["statistic"],
                          n_terms=s["n_terms"], decoy_p=s.get("decoy_p"), slip=s["slip"], channel=s["channel"],
-                         preprocessing=s["preprocessing"], band_hz=s["band_hz"], votes=s["votes"],
+                         preprocessing=s["preprocessing"], band_hz=s["band_hz"], votes=s["votes"], views=s.get("views"),
                          not_called=s.get("not_called"),
                          harmonics=[{k: ln[k] for k in ("harmonic", "sideband", "hz", "db")} for ln in s["lines"]]))
     return rows, ev
