@@ -537,10 +537,10 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     spectra += _fused(spectra)
     for s in spectra:
         _explain(s, freqs, f1, shaft_hz or f1, f1_known, n_balls, shaft=shaft)
-    kg = spectra[0].kurtogram
     n_sp = len(spectra)
     if not n_sp:
         raise ParameterError(f"whitening={whitening!r} selects no pre-processing; choose from {WHITENING}")
+    kg = spectra[0].kurtogram
     votes = {name: [s for s in spectra if s.primary == name] for name in FAMILIES}
     n_views = _views(spectra)   # how many distinct views the record offers (one with a user's band= and channel)
     fams = {}
