@@ -29,8 +29,9 @@ Pipeline for one record (``bearing_evidence``):
    and the p-value is multiplied by the number of slip positions, bins and sub-models searched
    (Bonferroni), then by the number of spectra searched (channels x pre-processings).
 5. decide: families whose corrected p-value is below ``ALPHA``, that show at least two lines, one of
-   them at one of their first three harmonics, and that claim first in two of the record's spectra
-   (or in one with a p-value below ``SINGLE_VIEW_P``, ``_one_view``) are found; the confidence is the posterior
+   them at one of their first three harmonics, and that claim first in two views of the record
+   (``_views``: channels, or bands of one channel that are mostly not the same; or in one view with a
+   p-value below ``SINGLE_VIEW_P``, ``_one_view``) are found; the confidence is the posterior
    probability from the p-value's Bayes-factor bound 1 / (-e p ln p) (Sellke, Bayarri & Berger
    2001) with prior odds ``PRIOR_ODDS`` per family.
 """
