@@ -119,3 +119,30 @@ def test_impacts_stand_at_their_exact_times():
     away = (np.abs(tt - t0) > 10 / fs) & (tt - t0 < 7 * tau)   # the smoothed onset and the cut tail left out
     assert np.max(np.abs(y - ref)[away]) < 0.02 * np.max(np.abs(ref))      # measured 1.3 %
     assert np.corrcoef(y, ref)[0, 1] > 0.97                                 # measured 0.983, onset included
+
+
+def test_healthy_residual_unbalance_keeps_its_velocity_at_every_speed():
+    # a rotor balanced to a quality grade (eccentricity x speed fixed): its 1X acceleration grows with the
+    # speed and its 1X velocity stays 0.02 g / (2 pi 29.95 Hz) peak = 1.04 mm/s. Fixed in g, the level read
+    # 1.7 mm/s RMS at 1200 rpm and a healthy slow machine was called unbalance
+    v1 = []
+    for rpm in (600.0, 1797.0, 3600.0):
+        rec = vm.synth.machine(fault="none", rpm=rpm, duration=10.0, seed=1)
+        x = rec.channel("acc")
+        f1 = rpm / 60.0
+        t = np.arange(x.size) / rec.fs
+        a1 = 2 * abs(np.mean(x * np.exp(-2j * np.pi * f1 * t)))       # 1X amplitude in g (whole cycles)
+        v1.append(a1 * 9.80665 / (2 * np.pi * f1) * 1e3)               # mm/s peak
+        d = vm.diagnose(rec, bearing="6205-2RS", machine_group=2, foundation="rigid")
+        assert d.top == "none" and d.severity["zone"] == "A", (rpm, d.reason)
+    # the residual's 1X sits under broadband noise of the same record: 5 % covers what the noise adds
+    assert v1 == pytest.approx([1.04] * 3, rel=0.05)
+    # a run-up 600 -> 1800 rpm: the 1X acceleration follows the speed (about 0.7 and 1.9 x 0.0067 g over
+    # the first and last second, whose mean speeds are 700 and 1700 rpm)
+    rec = vm.synth.machine(fault="none", rpm=(600.0, 1800.0), duration=6.0, seed=1)
+    x, fs = rec.channel("acc"), rec.fs
+    t = np.arange(x.size) / fs
+    theta = (600.0 * t + 1200.0 * t ** 2 / 12.0) / 60.0
+    z = x * np.exp(-2j * np.pi * theta)
+    first, last = 2 * abs(z[: int(fs)].mean()), 2 * abs(z[-int(fs):].mean())
+    assert first == pytest.approx(0.02 * 700 / 1797, rel=0.1) and last == pytest.approx(0.02 * 1700 / 1797, rel=0.1)
