@@ -274,6 +274,48 @@ def test_mat_struct_arrays_by_element_name_or_index(tmp_path):
     np.testing.assert_array_equal(vm.read(f, fs=1000, channels="N15.S(2).Data").data[0], S[0, 1]["Data"].ravel())
 
 
+def test_mat_v73_struct_arrays_by_element_name_or_index(tmp_path):
+    # the same layout saved as MATLAB v7.3 (HDF5): a struct array's fields are datasets of references,
+    # one per element, stored transposed, to values in #refs# (chars as UTF-16 codes); a cell field
+    # holds references too and is no signal
+    rng = np.random.default_rng(6)
+    p = tmp_path / "v73_struct.mat"
+    values = {}
+    with h5py.File(p, "w", userblock_size=512) as f:
+        refs = f.create_group("#refs#")
+
+        def put(arr, cls):
+            d = refs.create_dataset(f"r{len(refs)}", data=arr)
+            d.attrs["MATLAB_class"] = np.bytes_(cls)
+            return d.ref
+
+        def text(t):
+            return put(np.array([[ord(c)] for c in t], dtype=np.uint16), "char")
+
+        def struct_array(group, names, data):
+            group.attrs["MATLAB_class"] = np.bytes_("struct")
+            group.create_dataset("Name", data=np.array([[text(t)] for t in names], dtype=h5py.ref_dtype))
+            group.create_dataset("Data", data=np.array([[put(x[:, None], "double")] for x in data],
+                                                       dtype=h5py.ref_dtype))
+            c = group.create_dataset("Note", data=np.array([[text("x")] for _ in names], dtype=h5py.ref_dtype))
+            c.attrs["MATLAB_class"] = np.bytes_("cell")
+
+        top = f.create_group("N15")
+        top.attrs["MATLAB_class"] = np.bytes_("struct")
+        values["Y"] = [rng.normal(size=640) for _ in range(3)]
+        struct_array(top.create_group("Y"), ["phase_current_1", "vibration_1", "force"], values["Y"])
+        values["S"] = [rng.normal(size=64) for _ in range(2)]
+        struct_array(top.create_group("S"), ["a", "a"], values["S"])     # names not distinct: by index
+        top.create_dataset("fs", data=np.array([[64000.0]]))
+    with open(p, "r+b") as fh:
+        fh.write(b"MATLAB 7.3 MAT-file".ljust(116, b" ") + struct.pack("<8x") + b"\x00\x02IM")
+    rec = vm.read(p)
+    assert rec.fs == 64000.0
+    assert rec.names == ["N15.Y.phase_current_1.Data", "N15.Y.vibration_1.Data", "N15.Y.force.Data"]
+    np.testing.assert_array_equal(vm.read(p, channels=["N15.Y.vibration_1.Data"]).data[0], values["Y"][1])
+    np.testing.assert_array_equal(vm.read(p, channels="N15.S(2).Data").data[0], values["S"][1])
+
+
 def test_a_file_named_by_its_time_stamp_is_read_by_its_content(tmp_path):
     # the IMS rig names its files by time stamp (2004.02.12.10.32.39: the "ending" is .39) and writes
     # tab-separated columns without a header: the content decides the format

@@ -2,9 +2,9 @@
 
 Variables and nested struct fields are addressed by dotted paths (``"bearing.gs"``,
 ``"Fe.Out.Acc"``); a matrix variable gives one channel per row (``"Fe.Out.Acc[0]"``); the elements
-of a struct array by their Name field (``"N15.Y.vibration_1.Data"``) or 1-based index
-(``"S(2).Data"``). The sampling rate comes from ``fs``, a sample-rate variable in the file, or a
-time vector.
+of a struct array (v5, and v7.3, where each field holds references to the elements' values) by
+their Name field (``"N15.Y.vibration_1.Data"``) or 1-based index (``"S(2).Data"``). The sampling rate
+comes from ``fs``, a sample-rate variable in the file, or a time vector.
 """
 
 from __future__ import annotations
@@ -62,9 +62,7 @@ def _element_labels(v: np.ndarray) -> list[str]:
     element has a distinct one that is a plain identifier, else "(i)", 1-based as in MATLAB."""
     fld = next((f for f in ("Name", "name") if f in v.dtype.names), None)
     names = [_text(el[fld]) for el in v.flat] if fld else []
-    if fld and len(set(names)) == v.size and all(n and re.fullmatch(r"[A-Za-z_]\w*", n) for n in names):
-        return [f".{n}" for n in names]
-    return [f"({i + 1})" for i in range(v.size)]
+    return [_label(names, i, v.size) for i in range(v.size)]
 
 
 def _text(x) -> str | None:
@@ -87,29 +85,81 @@ def _leaves_v73(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
     except OSError as exc:
         raise ParameterError(f"MAT file {str(path)!r} is unreadable (truncated, or v7.3 damaged): {exc}") from None
     out: dict[str, np.ndarray] = {}
-    with f:
-        skip: list[str] = []
 
-        def visit(name, obj):
-            if isinstance(obj, h5py.Group) and obj.attrs.get("MATLAB_sparse") is not None:
-                skip.append(name + "/")   # a sparse matrix: its data/ir/jc parts are no signals
-            if name.startswith("#refs#") or not isinstance(obj, h5py.Dataset) or name.startswith(tuple(skip)):
-                return
-            cls = obj.attrs.get("MATLAB_class")
-            cls = cls.decode() if isinstance(cls, bytes) else cls
-            if cls in ("char", "logical", "cell", "struct") or obj.attrs.get("MATLAB_empty"):
-                return                    # text, flags and empty variables are no signals
-            if obj.dtype.kind not in "fiucb" and not obj.dtype.names:
-                return
+    def cls(obj):
+        c = obj.attrs.get("MATLAB_class")
+        return c.decode() if isinstance(c, bytes) else c
+
+    def is_ref(obj):
+        return isinstance(obj, h5py.Dataset) and h5py.check_ref_dtype(obj.dtype) is not None
+
+    def leaf(obj, name):
+        if cls(obj) in ("char", "logical", "cell", "struct") or obj.attrs.get("MATLAB_empty"):
+            return                    # text, flags and empty variables are no signals
+        if obj.dtype.kind not in "fiucb" and not obj.dtype.names:
+            return
+        if max_samples is not None:
+            check_size(int(np.prod(obj.shape, dtype=np.float64)), source=f"MAT file {str(path)!r}",
+                       max_samples=max_samples, what=f"variable {name!r}")
+        a = obj[()]
+        if a.dtype.names and set(a.dtype.names) >= {"real", "imag"}:
+            a = a["real"] + 1j * a["imag"]
+        out[name] = np.asarray(a).T  # MATLAB is column-major
+
+    def walk(obj, name):
+        if isinstance(obj, h5py.Dataset):
+            if not is_ref(obj):   # references: a cell array (no signals), or a struct array's field (below)
+                leaf(obj, name)
+            return
+        if obj.attrs.get("MATLAB_sparse") is not None:
+            return                    # a sparse matrix: its data/ir/jc parts are no signals
+        fields = [k for k in obj.keys() if not k.startswith("#")]
+        refs = {k: obj[k] for k in fields if is_ref(obj[k]) and cls(obj[k]) != "cell"}
+        if cls(obj) == "struct" and refs:
+            # a struct array (the Paderborn rig's Y(1..7)): each field holds one reference per element,
+            # stored transposed, so a C-order ravel is MATLAB's element order
             if max_samples is not None:
-                check_size(int(np.prod(obj.shape, dtype=np.float64)), source=f"MAT file {str(path)!r}",
-                           max_samples=max_samples, what=f"variable {name!r}")
-            a = obj[()]
-            if a.dtype.names and set(a.dtype.names) >= {"real", "imag"}:
-                a = a["real"] + 1j * a["imag"]
-            out[name.replace("/", ".")] = np.asarray(a).T  # MATLAB is column-major
-        f.visititems(visit)
+                for k, d in refs.items():
+                    check_size(int(np.prod(d.shape, dtype=np.float64)), source=f"MAT file {str(path)!r}",
+                               max_samples=max_samples, what=f"struct array field {name}.{k!s}")
+            cells = {k: d[()].ravel() for k, d in refs.items()}
+            n = min(v.size for v in cells.values())
+            fld = next((k for k in ("Name", "name") if k in cells), None)
+            names = [_text73(f[r]) for r in cells[fld][:n]] if fld else []
+            for i in range(n):
+                label = _label(names, i, n)
+                for k, v in cells.items():
+                    if v[i]:
+                        walk(f[v[i]], f"{name}{label}.{k}")
+            return
+        for k in fields:
+            walk(obj[k], f"{name}.{k}" if name else k)
+
+    with f:
+        try:
+            walk(f, "")
+        except ParameterError:
+            raise
+        except (OSError, KeyError, ValueError, RuntimeError) as exc:   # a damaged object or reference
+            raise ParameterError(f"MAT file {str(path)!r} is unreadable (v7.3 damaged): {exc}") from None
     return out
+
+
+def _label(names: list, i: int, n: int) -> str:
+    """A struct array element's path part: ".name" when every element has a distinct identifier name,
+    else "(i)", 1-based as in MATLAB."""
+    if len(names) == n and len(set(names)) == n and all(m and re.fullmatch(r"[A-Za-z_]\w*", m) for m in names):
+        return f".{names[i]}"
+    return f"({i + 1})"
+
+
+def _text73(obj) -> str | None:
+    """A v7.3 char dataset (UTF-16 code units) as text, else None."""
+    import h5py
+    if not isinstance(obj, h5py.Dataset) or obj.attrs.get("MATLAB_class") not in (b"char", "char"):
+        return None
+    codes = np.asarray(obj[()]).T.ravel()
+    return "".join(map(chr, codes.astype(np.int64))).strip() if codes.size < 256 else None
 
 
 def _signal_rows(a: np.ndarray) -> np.ndarray | None:
