@@ -314,6 +314,17 @@ def test_mat_v73_struct_arrays_by_element_name_or_index(tmp_path):
     assert rec.names == ["N15.Y.phase_current_1.Data", "N15.Y.vibration_1.Data", "N15.Y.force.Data"]
     np.testing.assert_array_equal(vm.read(p, channels=["N15.Y.vibration_1.Data"]).data[0], values["Y"][1])
     np.testing.assert_array_equal(vm.read(p, channels="N15.S(2).Data").data[0], values["S"][1])
+    # a hostile file whose struct array refers back to itself: the named error, not a recursion
+    q = tmp_path / "cycle.mat"
+    with h5py.File(q, "w", userblock_size=512) as f:
+        g = f.create_group("S")
+        g.attrs["MATLAB_class"] = np.bytes_("struct")
+        g.create_dataset("Data", data=np.array([[g.ref], [g.ref]], dtype=h5py.ref_dtype))
+        f.create_dataset("fs", data=np.array([[1000.0]]))
+    with open(q, "r+b") as fh:
+        fh.write(b"MATLAB 7.3 MAT-file".ljust(116, b" ") + struct.pack("<8x") + b"\x00\x02IM")
+    with pytest.raises(vm.ParameterError, match="refers back to itself"):
+        vm.read(q)
 
 
 def test_a_file_named_by_its_time_stamp_is_read_by_its_content(tmp_path):

@@ -140,6 +140,9 @@ def _leaves_v73(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
             walk(f, "")
         except ParameterError:
             raise
+        except RecursionError:
+            raise ParameterError(f"MAT file {str(path)!r} is unreadable (v7.3 damaged): a struct array refers back "
+                                 "to itself") from None
         except (OSError, KeyError, ValueError, RuntimeError) as exc:   # a damaged object or reference
             raise ParameterError(f"MAT file {str(path)!r} is unreadable (v7.3 damaged): {exc}") from None
     return out
