@@ -123,8 +123,8 @@ def test_impacts_stand_at_their_exact_times():
 
 def test_healthy_residual_unbalance_keeps_its_velocity_at_every_speed():
     # a rotor balanced to a quality grade (eccentricity x speed fixed): its 1X acceleration grows with the
-    # speed and its 1X velocity stays 0.02 g / (2 pi 29.95 Hz) peak = 1.04 mm/s. Fixed in g, the level read
-    # 1.7 mm/s RMS at 1200 rpm and a healthy slow machine was called unbalance
+    # speed and its 1X velocity stays 0.02 g / (2 pi 29.95 Hz) peak = 1.04 mm/s. Fixed in g, a healthy
+    # machine at 600 rpm read 2.2 mm/s RMS (zone B) and was called unbalance
     v1 = []
     for rpm in (600.0, 1797.0, 3600.0):
         rec = vm.synth.machine(fault="none", rpm=rpm, duration=10.0, seed=1)
