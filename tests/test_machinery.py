@@ -215,6 +215,20 @@ def test_without_a_unit_shaft_order_faults_are_not_gated_and_the_answer_says_so(
     assert code == 0 and "severity: not computed, the unit is unknown" in out
 
 
+def test_a_real_record_rebuilt_from_an_array_with_its_unit_keeps_the_iso_gate(shared_data):
+    # the fan-end channel of CWRU B007_0 (fan-end ball fault, 0.29 mm/s, zone A) rebuilt with
+    # Record.from_array(..., unit="g"): the quantity used to stay "unknown", the ISO level was then not
+    # computed and its five harmonics above 2X were called looseness (0.75 at 48 kHz); with the unit's
+    # quantity the level gates the shaft-order faults as for the record read from its file
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.read(shared_data("cwru_fe/B007_0.mat"), fs=12000, unit="g", channels=["X282_FE_time"])
+    again = vm.Record.from_array(rec.data[0], fs=rec.fs, unit="g", name="X282_FE_time")
+    d = vm.diagnose(again, rpm=rec.meta["rpm"], bearing="6203-2RS")
+    assert "unit_unknown" not in d.flags and d.severity["zone"] == "A"
+    assert d.severity["velocity_rms_mm_s"] == pytest.approx(0.29, abs=0.01)   # as read from the file
+    assert d.top == "none" and d.faults.set_index("fault").loc["looseness", "confidence"] == 0.0
+
+
 def test_the_cli_names_a_band_left_out_above_a_filter_edge(tmp_path):
     # an outer-race machine recorded at 12 kHz, resampled to 48 kHz and stored as HDF5: the CLI says
     # that the channel measures up to about 6.6 kHz and still finds the outer race

@@ -15,6 +15,16 @@ def test_from_array_and_shape():
     np.testing.assert_array_equal(r.time, np.arange(10) / 100.0)
 
 
+def test_a_unit_names_its_quantity():
+    # unit="g" alone is an acceleration (as vm.read and the CLI take it); a unit of another quantity given
+    # with a quantity is still refused, and no unit leaves the quantity unknown
+    assert vm.Record.from_array(np.ones(4), fs=1.0, unit="g").channels[0].quantity == "acceleration"
+    assert vm.Channel("v", unit="mm/s").quantity == "velocity"
+    assert vm.Record.from_array(np.ones(4), fs=1.0).channels[0].quantity == "unknown"
+    with pytest.raises(vm.ParameterError, match="measures acceleration"):
+        vm.Channel("x", "velocity", "g")
+
+
 def test_immutable_and_copied():
     x = np.zeros(5)
     r = vm.Record.from_array(x, fs=1.0)

@@ -27,7 +27,12 @@ class Channel:
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise ParameterError(f"Channel name={self.name!r} must be a non-empty string")
-        object.__setattr__(self, "unit", _units.check_unit(self.quantity, self.unit))
+        unit = _units.check_unit(self.quantity, self.unit)
+        object.__setattr__(self, "unit", unit)
+        if self.quantity == "unknown" and unit:
+            # a unit names its quantity ("g" is an acceleration), as the readers and the CLI take it: left
+            # "unknown", a record made with unit="g" would lose its ISO 10816 level in vm.diagnose
+            object.__setattr__(self, "quantity", _units.quantity_of(unit))
 
 
 def _freeze(a: np.ndarray) -> np.ndarray:
