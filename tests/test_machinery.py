@@ -197,22 +197,33 @@ def test_plot_diagnosis_shows_ses_comb_and_kurtogram(shared_data, tmp_path):
     assert (tmp_path / "d.png").stat().st_size > 10_000
 
 
-def test_without_a_unit_shaft_order_faults_are_not_gated_and_the_answer_says_so(tmp_path):
+def test_without_a_unit_level_gated_faults_are_named_but_not_called(tmp_path, shared_data):
     # a looseness machine whose samples come without a unit: the ISO level cannot be computed, so the
-    # shaft-order evidence stands alone; the answer and the CLI say that the severity gate was off
+    # looseness pattern is named as the strongest one but not called, and the "none" says little; with
+    # the unit it is called
     warnings.simplefilter("ignore", vm.QualityWarning)
     rec = vm.synth.machine(fault="looseness", snr_db=10, seed=3, duration=6.0)
     bare = vm.Record.from_array(rec.data[0], fs=rec.fs)
     d = vm.diagnose(bare, rpm=rec.meta["rpm"])
-    assert d.top == "looseness" and "unit_unknown" in d.flags and d.severity["zone"] is None
-    assert "not weighed against the ISO 10816-3 level" in d.reason
+    assert d.top == "none" and "unit_unknown" in d.flags and d.severity["zone"] is None
+    assert "the data's unit is unknown" in d.reason and "strongest pattern looseness" in d.reason
+    row = d.faults.set_index("fault").loc["looseness"]
+    assert row.confidence == 0.0 and row.pattern > 0.5 and row.note.startswith("not called")
+    assert d.confidence < 0.1   # the pattern speaks against "none" even though it cannot be weighed
     known = vm.diagnose(rec)
-    assert known.top == "looseness" and "not weighed" not in known.reason
+    assert known.top == "looseness" and "unit is unknown" not in known.reason
+    # CWRU B007_1 (fan-end ball fault) read without a unit: its shaft harmonics make the looseness pattern
+    # at full score, which was called at 1.00 before; with unit="g" the fan-end channel is at 0.88 mm/s,
+    # zone A, and looseness scores 0.26
+    raw = vm.read(shared_data("cwru_fe/B007_1.mat"), fs=12000, channels=["X283_FE_time"])
+    db = vm.diagnose(raw, bearing="6203-2RS")
+    assert db.top == "none" and db.faults.set_index("fault").loc["looseness"].pattern == 1.0
     path = tmp_path / "bare.csv"
     np.savetxt(path, bare.data[0][:, None], header="acc", comments="", delimiter=",")
     from tests.test_cli import run
     code, out, _ = run(["diagnose", str(path), "--fs", str(rec.fs), "--rpm", str(rec.meta["rpm"])])
     assert code == 0 and "severity: not computed, the unit is unknown" in out
+    assert "looseness" in out and "(not called: unit unknown)" in out
 
 
 def test_a_real_record_rebuilt_from_an_array_with_its_unit_keeps_the_iso_gate(shared_data):

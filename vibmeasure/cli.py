@@ -450,8 +450,8 @@ def _main_diagnose(args, out, err) -> int:
             print(f"  speed: declared {dec:g} rpm, estimated "
                   f"{'n/a' if est is None else format(est, '.1f')} rpm {diag.speed['note']}", file=out)
         if sev.get("velocity_rms_mm_s") is None and "unit_unknown" in diag.flags:
-            print("  severity: not computed, the unit is unknown (give --unit): shaft-order faults are not "
-                  "gated by the ISO level", file=out)
+            print("  severity: not computed, the unit is unknown (give --unit): level-gated shaft-order faults "
+                  "are named as patterns, not called", file=out)
         if sev.get("velocity_rms_mm_s") is not None:
             print(f"  severity: {sev['velocity_rms_mm_s']:.2f} mm/s RMS ({sev['band_hz'][0]:g}-1000 Hz), ISO 10816-3 "
                   f"group {sev['group']} {sev['foundation']}: zone {sev['zone']} {sev['note']}", file=out)
@@ -464,6 +464,9 @@ def _main_diagnose(args, out, err) -> int:
         for _, r in diag.faults.iterrows():
             p = r.get("p_value")
             extra = f"  p = {p:.2g} ({r.channel}, {r.preprocessing})" if p is not None and p == p and p < 1 else ""
+            pat = r.get("pattern")
+            if pat is not None and pat == pat and pat > 0:
+                extra += f"  pattern {pat:.2f} (not called: unit unknown)"
             print(f"  {r.fault:20s} expected {r.expected_hz:9.2f} Hz  score {r.confidence:.2f}{extra}", file=out)
     if args.plot:
         print(f"vibmeasure: wrote {args.plot}", file=err)

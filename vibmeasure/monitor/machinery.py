@@ -485,6 +485,27 @@ def _bearing_rows(job: _Job, f1: float, speed: dict):
 
 # --- decision ---------------------------------------------------------------------------------------
 
+LEVEL_GATED = ("unbalance", "misalignment", "looseness", "resonance", "electrical")
+
+
+def _unweighed(rows) -> tuple | None:
+    """Without the data's unit the ISO level is unknown, and the level-gated faults (LEVEL_GATED) are
+    patterns only: every machine has shaft harmonics, and their level is what tells a fault. Measured on
+    the 57 development records read without a unit, the patterns alone named looseness on 4 bearing-fault
+    records (B007_1 at 1.00), against none with unit="g"; and the confidence maps were learnt on gated
+    scores. Such rows keep their pattern score (``pattern``, which a "none" still weighs) but are not
+    called. Returns (strongest pattern, its score) or None."""
+    best = None
+    for r in rows:
+        if r["fault"] in LEVEL_GATED:
+            r["pattern"] = r["confidence"]
+            if r["confidence"] > 0:
+                r["note"] = "not called, the data's unit is unknown: " + r["note"]
+                if best is None or r["confidence"] > best[1]:
+                    best = (r["fault"], r["confidence"])
+            r["confidence"] = 0.0
+    return best
+
 def _decide(table, job: _Job):
     """The top fault: the most confident shaft-order or bearing fault at TOP_CONFIDENCE or more and not
     tied with another of its own kind; else "none" with the reason and the strongest candidate."""
@@ -540,7 +561,9 @@ def _p_none(table) -> tuple[float, float]:
     shaft-order families, and over the bearing families of 1 - their posterior from the p-value. The
     score of "none" is their product; each part is calibrated on its own (monitor/calibration.py)."""
     from .bearing_faults import _log_p_to_conf
-    shaft = table[table.fault.isin(SHAFT_FAULTS)].confidence.to_numpy()
+    sel = table[table.fault.isin(SHAFT_FAULTS)]
+    # a pattern not called for want of the unit still speaks against "none" (_unweighed)
+    shaft = (sel.pattern.fillna(sel.confidence) if "pattern" in sel else sel.confidence).to_numpy(float)
     s_shaft = float(np.prod(1 - shaft)) if shaft.size else 1.0
     bear = table[table.fault.isin(list(FAMILIES))]
     s_bear = 1.0
@@ -619,14 +642,16 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
             if r["fault"] in SHAFT_FAULTS and r["confidence"] > 0:
                 r["note"] = "not called, the speed varies over the record: " + r["note"]
                 r["confidence"] = 0.0
+    unweighed = _unweighed(rows) if "unit_unknown" in job.flags else None
     import pandas as pd
     table = pd.DataFrame(rows).sort_values("confidence", ascending=False, ignore_index=True)
     top, conf, reason, also, where, (kind, score, parts) = _decide(table, job)
+    if unweighed:
+        reason += (f"; shaft-order faults not called: the data's unit is unknown, so the ISO 10816-3 level that "
+                   f"shows whether they matter cannot be computed (give unit=, e.g. 'g'); strongest pattern "
+                   f"{unweighed[0]} at score {unweighed[1]:.2f}")
     if {"speed_inconsistent", "order_tracked", "speed_varies"} & set(job.flags):
         reason += "; " + speed["note"]
-    if "unit_unknown" in job.flags and top in SHAFT_FAULTS:
-        reason += ("; the data's unit is unknown, so this shaft-order fault was not weighed against the ISO "
-                   "10816-3 level (give unit=, e.g. 'g')")
     if narrow:
         reason += ("; " + ", ".join(f"{k} measures only up to {v:.0f} Hz" for k, v in narrow)
                    + " (above: a filter's stop band): the envelope bands reach down among the shaft harmonics")
