@@ -358,7 +358,9 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
                 size = max(1, min(MAX_PER_TASK, len(todo) // (8 * n_w)))
                 chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
                 futs = dask_client.map(analyse_files, chunks, tasks=tasks, options=options, retries=2, pure=False)
-                for batch_done in as_completed(futs, with_results=True).batches():
+                # the futures' own client's loop: as_completed otherwise takes the default client's, and
+                # with two clients in one process that can hang (dask/distributed issue 4357)
+                for batch_done in as_completed(futs, loop=dask_client.loop, with_results=True).batches():
                     for fut, outs in batch_done:
                         for out in outs:
                             take(out)
