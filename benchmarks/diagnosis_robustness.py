@@ -1,5 +1,5 @@
 """Machine diagnosis on the development records when they come in another shape: resampled, low-passed,
-with an interference tone, with added noise, cut shorter, with a slightly wrong speed. Held-out
+with an interference tone, with added noise, cut shorter, with a wrong declared speed (1 and 5 %). Held-out
 recordings come from other rigs and converters; a method that generalises keeps its answers (or says
 "none") and does not start making wrong calls.
 
@@ -62,6 +62,9 @@ VARIANTS = {
     "noise at the record's RMS": lambda rec, rpm: (_rebuilt(rec, rec.data + np.random.default_rng(0).normal(
         size=rec.data.shape) * rec.data.std(axis=1, keepdims=True)), rpm),
     "rpm declared 1 % high": lambda rec, rpm: (rec, 1.01 * rpm),
+    # a nameplate or synchronous speed against one under load: the 1X is looked for within +-6 %
+    "rpm declared 5 % high": lambda rec, rpm: (rec, 1.05 * rpm),
+    "rpm declared 5 % low": lambda rec, rpm: (rec, 0.95 * rpm),
     "first 4 s": lambda rec, rpm: (_rebuilt(rec, rec.data[:, :int(4 * rec.fs)]), rpm),
     **{f"quarter {k + 1} of 4 (fan end only)": _piece(k, 4) for k in range(4)},
 }
