@@ -520,6 +520,7 @@ def _unweighed(rows) -> tuple | None:
             r["confidence"] = 0.0
     return best
 
+
 def _decide(table, job: _Job):
     """The top fault: the most confident shaft-order or bearing fault at TOP_CONFIDENCE or more and not
     tied with another of its own kind; else "none" with the reason and the strongest candidate."""
