@@ -255,6 +255,24 @@ def test_a_speed_declared_5_percent_fast_is_corrected_from_the_1x_line(shared_da
     assert "speed_corrected" not in d0.flags and d0.top == "bearing_outer_race"
 
 
+def test_inner_race_sidebands_are_not_taken_for_a_ball_comb_in_one_channel(shared_data):
+    # CWRU IR021_3 (fan-end inner race, 1737 rpm), one sensor at a time. Its lines BPFI - 1X, 2 BPFI - 2X
+    # and 3 BPFI - 3X (114.4, 228.8, 343.2 Hz) sit 0.85 % below 2 x BSF's first three harmonics (the
+    # 6203's 2 x BSF is 3.987 X, BPFI - 1X 3.947 X). When the claim order went by carriers, the ball
+    # comb claimed them first in either channel alone and was called (p = 2e-15); now the inner race's
+    # comb with its +-1X sidebands, far more significant, explains them: the drive-end channel is called
+    # inner race, the fan-end one (whose BPFI carriers are weak) "none" with the inner race named
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.read(shared_data("cwru_fe/IR021_3.mat"), fs=12000, unit="g")
+    de = vm.diagnose(rec, bearing="6203-2RS", channel="X273_DE_time", channels=["X273_DE_time"])
+    assert de.top == "bearing_inner_race" and de.confidence > 0.9
+    fe = vm.diagnose(rec, bearing="6203-2RS", channel="X273_FE_time", channels=["X273_FE_time"])
+    assert fe.top == "none" and "strongest bearing candidate bearing_inner_race" in fe.reason
+    for d in (de, fe):
+        ball = d.faults.set_index("fault").loc["bearing_ball"]
+        assert ball["confidence"] == 0.0 and "114.4 Hz" not in ball["note"]
+
+
 def test_a_speed_declared_10_percent_off_is_corrected_from_the_1x_and_its_harmonics(shared_data):
     # the same record declared 10 % slow and 10 % fast (a drive's set point, a wrong nameplate): the 1X
     # lies 9-11 % away, outside the former +-6 % search, which took other lines for it (1660 and 2038
