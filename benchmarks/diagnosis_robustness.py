@@ -1,6 +1,6 @@
 """Machine diagnosis on the development records when they come in another shape: resampled, low-passed,
 with an interference tone, with added noise, cut shorter, with a wrong declared speed (1, 5 and 10 %), one
-channel alone. Held-out recordings come from other rigs and converters, often with one sensor; a method
+channel alone (whole, and in 1 s pieces). Held-out recordings come from other rigs and converters, often with one sensor; a method
 that generalises keeps its answers (or says "none") and does not start making wrong calls.
 
 Every fault record of ../shared/data/cwru_fe (45) and mfpt (8) goes through vm.diagnose once per
@@ -50,11 +50,17 @@ def _piece(k, m):
     return f
 
 
-def _alone(suffix):
-    """One channel of a CWRU fan-end record, as a single-sensor recording would have it."""
+def _alone(suffix, seconds=None):
+    """One channel of a CWRU fan-end record, as a single-sensor recording would have it; with
+    ``seconds``, the list of its pieces of that length (the IMS rig records 1 s)."""
     def f(rec, rpm):
         i = next(i for i, n in enumerate(rec.names) if n.endswith(suffix))
-        return vm.Record.from_array(rec.data[i], fs=rec.fs, names=[rec.names[i]], unit="g"), rpm
+        x = rec.data[i]
+        if seconds is None:
+            return vm.Record.from_array(x, fs=rec.fs, names=[rec.names[i]], unit="g"), rpm
+        n = int(seconds * rec.fs)
+        return [(vm.Record.from_array(x[k * n:(k + 1) * n], fs=rec.fs, names=[rec.names[i]], unit="g"), rpm)
+                for k in range(x.size // n)]
     return f
 
 
@@ -81,6 +87,8 @@ VARIANTS = {
     # the fault is in the fan-end bearing: its own sensor, the drive end's across the motor, the base's
     **{f"{where} channel alone (fan end only)": _alone(suffix)
        for where, suffix in (("fan-end", "_FE_time"), ("drive-end", "_DE_time"), ("base", "_BA_time"))},
+    **{f"{where} channel alone, 1 s pieces (fan end only)": _alone(suffix, 1.0)
+       for where, suffix in (("fan-end", "_FE_time"), ("drive-end", "_DE_time"), ("base", "_BA_time"))},
 }
 
 
@@ -91,7 +99,7 @@ def main(names, guards=True):
         bf.TAPER = 0.0
         bf._measured_top = lambda X, fs, n: fs / 2
     recs = [r for r in records() if r[0] in ("cwru_fe", "mfpt")]
-    print(f"{'variant':40s} {'right':>6} {'none':>6} {'wrong':>6}  time   (guards {'on' if guards else 'off'})")
+    print(f"{'variant':52s} {'right':>6} {'none':>6} {'wrong':>6}  time   (guards {'on' if guards else 'off'})")
     total = dict.fromkeys(("right", "none", "wrong"), 0)
     for name in names:
         make = VARIANTS[name]
@@ -99,17 +107,18 @@ def main(names, guards=True):
         for dset, fname, rec, rpm, bearing, truth, channel in recs:
             if name.endswith("(fan end only)") and dset != "cwru_fe":
                 continue   # the MFPT records are 3 s (a quarter is under 20 revolutions) and have one channel
-            r, s = make(rec, rpm)
-            d = vm.diagnose(r, rpm=s, bearing=bearing, channel=channel if channel in r.names else None)
-            top = scored(d.top)   # a shaft-order or gear fault named on a bearing-fault record is wrong
-            k = "right" if top == truth else "none" if top == "none" else "wrong"
-            counts[k] += 1
-            if k == "wrong":
-                wrong.append(f"{fname} ({truth} -> {d.top})")
-        print(f"{name:40s} {counts['right']:>6} {counts['none']:>6} {counts['wrong']:>6}  "
+            made = make(rec, rpm)
+            for j, (r, s) in enumerate(made if isinstance(made, list) else [made]):
+                d = vm.diagnose(r, rpm=s, bearing=bearing, channel=channel if channel in r.names else None)
+                top = scored(d.top)   # a shaft-order or gear fault named on a bearing-fault record is wrong
+                k = "right" if top == truth else "none" if top == "none" else "wrong"
+                counts[k] += 1
+                if k == "wrong":
+                    wrong.append(f"{fname}{f' piece {j + 1}' if isinstance(made, list) else ''} ({truth} -> {d.top})")
+        print(f"{name:52s} {counts['right']:>6} {counts['none']:>6} {counts['wrong']:>6}  "
               f"{time.perf_counter() - t0:4.0f} s  {'; '.join(wrong)}", flush=True)
         total = {k: total[k] + counts[k] for k in total}
-    print(f"{f'all {len(names)} variants':40s} {total['right']:>6} {total['none']:>6} {total['wrong']:>6}")
+    print(f"{f'all {len(names)} variants':52s} {total['right']:>6} {total['none']:>6} {total['wrong']:>6}")
 
 
 if __name__ == "__main__":

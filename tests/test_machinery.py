@@ -258,19 +258,37 @@ def test_a_speed_declared_5_percent_fast_is_corrected_from_the_1x_line(shared_da
 def test_inner_race_sidebands_are_not_taken_for_a_ball_comb_in_one_channel(shared_data):
     # CWRU IR021_3 (fan-end inner race, 1737 rpm), one sensor at a time. Its lines BPFI - 1X, 2 BPFI - 2X
     # and 3 BPFI - 3X (114.4, 228.8, 343.2 Hz) sit 0.85 % below 2 x BSF's first three harmonics (the
-    # 6203's 2 x BSF is 3.987 X, BPFI - 1X 3.947 X). When the claim order went by carriers, the ball
+    # 6203's 2 x BSF is 3.987 X, BPFI - 1X 3.947 X). With the claim order by carriers alone, the ball
     # comb claimed them first in either channel alone and was called (p = 2e-15); now the inner race's
-    # comb with its +-1X sidebands, far more significant, explains them: the drive-end channel is called
-    # inner race, the fan-end one (whose BPFI carriers are weak) "none" with the inner race named
+    # comb with its +-1X sidebands, which explains the ball's lines and more in the selected bands,
+    # claims them there: the drive-end channel is called inner race (the ball keeps the whole band, where
+    # neither comb explains more than the other, and is the runner-up), the fan-end one (whose BPFI
+    # carriers are weak) "none" with the inner race named
     warnings.simplefilter("ignore", vm.QualityWarning)
     rec = vm.read(shared_data("cwru_fe/IR021_3.mat"), fs=12000, unit="g")
     de = vm.diagnose(rec, bearing="6203-2RS", channel="X273_DE_time", channels=["X273_DE_time"])
-    assert de.top == "bearing_inner_race" and de.confidence > 0.9
+    assert de.top == "bearing_inner_race" and de.confidence > 0.5   # a call (TOP_CONFIDENCE)
     fe = vm.diagnose(rec, bearing="6203-2RS", channel="X273_FE_time", channels=["X273_FE_time"])
     assert fe.top == "none" and "strongest bearing candidate bearing_inner_race" in fe.reason
     for d in (de, fe):
-        ball = d.faults.set_index("fault").loc["bearing_ball"]
-        assert ball["confidence"] == 0.0 and "114.4 Hz" not in ball["note"]
+        assert d.faults.set_index("fault").loc["bearing_ball", "confidence"] < 0.5   # not a call
+
+
+def test_outer_race_lines_with_1x_sidebands_stay_outer_race_in_one_second_pieces(shared_data):
+    # CWRU OR021@6_0 (fan-end outer race), 1 s pieces of the fan-end channel (the IMS rig's length).
+    # Its BPFO harmonics carry +-1X sidebands; at 1 Hz resolution they sit where BPFI's harmonics and
+    # their +-1X sidebands at +2 % slip would (the 6203's BPFO + BPFI is 8X), and that comb has more
+    # lines, so a claim order by p-value alone called inner race (in 5 of the 10 pieces, these 3 among
+    # them). The outer race, with more of its own first three harmonics, claims first: neither comb
+    # explains more than the other
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.read(shared_data("cwru_fe/OR021@6_0.mat"), fs=12000, unit="g")
+    x = rec.channel("X315_FE_time")
+    n = int(rec.fs)
+    for k in (0, 3, 5):
+        piece = vm.Record.from_array(x[k * n:(k + 1) * n], fs=rec.fs, names=["fe"], unit="g")
+        d = vm.diagnose(piece, rpm=rec.meta["rpm"], bearing="6203-2RS")
+        assert d.top == "bearing_outer_race", k
 
 
 def test_a_speed_declared_10_percent_off_is_corrected_from_the_1x_and_its_harmonics(shared_data):
