@@ -72,6 +72,28 @@ def test_comb_recovers_the_common_slip(rng):
     assert res["logp"] == pytest.approx(expected, abs=1e-6)
 
 
+def test_a_comb_that_fits_best_at_the_edge_of_the_slip_range_is_not_called(rng):
+    # a comb of broad lines (skirts falling e-fold in 20 bins, as a line smeared by speed changes)
+    # 1.3 % from BPFO peaks inside the +-2 % range; placed 2.5 % off, its best slip is the range's edge
+    # (the skirts still reach it, the peaks lie 0.5 % beyond), and a comb that would fit better further
+    # off is not this bearing's: it is significant but not accepted, and the reason says why
+    f0, df = 107.36, 0.1
+    for slip, edge in ((0.013, False), (-0.013, False), (0.025, True), (-0.025, True)):
+        r = rng.exponential(size=8000)
+        for h in (1, 2, 3):
+            i = int(round(h * f0 * (1 + slip) / df))
+            r[i - 60: i + 61] = np.maximum(r[i - 60: i + 61], 40.0 * np.exp(-np.abs(np.arange(-60, 61)) / 20.0))
+        res = bf._comb(_ses(r, df), f0, (1, 2, 3))
+        assert res["edge"] is edge, slip
+        assert res["logp"] < np.log(bf.ALPHA) and res["n_lines"] >= 2
+        assert bf._accepted(res) is not edge
+        if edge:
+            assert res["slip"] == pytest.approx(np.sign(slip) * bf.SLIP)
+            why = bf._not_called("bearing_outer_race", dict(bf._summary("bearing_outer_race", "BPFO", res, _ses(r, df),
+                                                                         {"BPFO": f0}, 1), votes=1, views=2), 1, 2)
+            assert "edge of the +-2 % slip range" in why
+
+
 def test_a_line_counts_for_one_family_only(rng):
     # 4 x BPFO (14.34 X) lies inside the window of 3 x 2xBSF (14.14 X, +-2 %): once the outer race has
     # claimed its harmonics, that line is no evidence for a ball fault

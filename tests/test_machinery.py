@@ -291,6 +291,20 @@ def test_outer_race_lines_with_1x_sidebands_stay_outer_race_in_one_second_pieces
         assert d.top == "bearing_outer_race", k
 
 
+def test_shaft_orders_fitting_bpfo_only_at_the_slip_edge_are_not_called(shared_data):
+    # CWRU IR021_0 (fan-end inner race, 1797 rpm), the drive-end channel's second second: 3X, 9X and 15X
+    # (89.5, 268.5, 447.4 Hz at 1 Hz resolution) stand as BPFO x 1, 3, 5 at -2.00 % slip, the edge of
+    # the search (the 6203's BPFO is 3.053 X); that was called outer race at confidence 1.00. A comb
+    # that fits best at the edge would fit better further off: "none", and the reason says so
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.read(shared_data("cwru_fe/IR021_0.mat"), fs=12000, unit="g")
+    x, n = rec.channel("X270_DE_time"), int(rec.fs)
+    d = vm.diagnose(vm.Record.from_array(x[n:2 * n], fs=rec.fs, names=["de"], unit="g"), rpm=rec.meta["rpm"],
+                    bearing="6203-2RS")
+    assert d.top == "none"
+    assert "bearing_outer_race" in d.reason and "edge of the +-2 % slip range" in d.reason
+
+
 def test_a_speed_declared_10_percent_off_is_corrected_from_the_1x_and_its_harmonics(shared_data):
     # the same record declared 10 % slow and 10 % fast (a drive's set point, a wrong nameplate): the 1X
     # lies 9-11 % away, outside the former +-6 % search, which took other lines for it (1660 and 2038

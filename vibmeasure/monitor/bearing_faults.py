@@ -185,6 +185,7 @@ def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
              for (h, k), p, v in zip(terms, pos[j], vals[j])]
     carriers = [v for (h, k), v in zip(terms, vals[j]) if k == 0]
     return {"logp": float(min(logp, 0.0)), "slip": float(s[j]), "stat": float(T[j]), "n_terms": n_t,
+            "edge": bool(j in (0, n_s - 1) and T[j] > T[n_s // 2]),
             "strength": float(np.sum(carriers)),
             "lines": lines, "n_lines": int(sum(v >= ses.r_line for v in vals[j])),
             "n_carriers": int(sum(v >= ses.r_line for (h, k), v in zip(terms, vals[j]) if k == 0 and h <= 3))}
@@ -371,9 +372,15 @@ def _accepted(res: dict | None) -> bool:
     """Significant, at least two lines, one of them at one of the first three harmonics of the family's
     own fundamental, and (inner race, ball) the modulation sidebands of the fault. (A comb of only its
     4th and 5th harmonics is more often the sidebands of another family: on a 1 s inner-race record of
-    the IMS rig's bearing, 3 x BPFI + 1X and 4 x BPFI - 1X read as 4 and 5 x BPFO at -1.9 % slip.)"""
+    the IMS rig's bearing, 3 x BPFI + 1X and 4 x BPFI - 1X read as 4 and 5 x BPFO at -1.9 % slip.)
+
+    And the comb's statistic peaks inside the slip range, not at its edge (``edge``): a comb that
+    fits best at -2 % or +2 % would fit better still further off, where no bearing line is. On 1 s
+    pieces of the development records' single channels, 566 calls were made: the 562 right ones had
+    slips within +-1.8 %; the only one at the edge was wrong (CWRU IR021_0's drive-end channel, piece 2:
+    3X, 9X and 15X taken for BPFO x 1, 3, 5 at -2.00 %; the 6203's BPFO is 3.053 X)."""
     return bool(res and res["n_lines"] >= 2 and res["n_carriers"] >= 1 and res["logp"] < np.log(ALPHA)
-                and res.get("modulation") != 0)
+                and res.get("modulation") != 0 and not res.get("edge"))
 
 
 def _survives(ses: _SES, name: str, claimant: str, freqs: dict, f1: float) -> bool:
@@ -671,6 +678,10 @@ def _not_called(name: str, fam: dict, n_sp: int, n_views: int) -> str | None:
         why.append(f"{fam['n_lines']} line(s) stand {10 * np.log10(R_LINE):.1f} dB above the floor, 2 needed")
     elif fam.get("n_carriers", 1) < 1:
         why.append("no line at one of the first three harmonics of its own fundamental")
+    if fam.get("edge"):
+        why.append(f"its comb fits best at the edge of the +-{100 * SLIP:g} % slip range, so it would fit better "
+                   "further off: the lines are not where this bearing puts them (a shaft-order comb, another "
+                   "family's sidebands)")
     if fam.get("modulation_sidebands") == 0:
         why.append("no +-1X sidebands (an inner-race defect turns through the load zone)"
                    if name == "bearing_inner_race" else
@@ -703,7 +714,8 @@ def _summary(name, key, res, ses, freqs, n_sp) -> dict:
     return {"fault": name, "expected_hz": expected, "found": found, "log_p": logp, "p_value": float(np.exp(logp)),
             "statistic": res["stat"], "n_terms": res["n_terms"],
             "log10_p": float(logp / np.log(10)), "slip": res["slip"], "found_hz": float(f0),
-            "lines": lines, "n_lines": res["n_lines"], "n_carriers": res["n_carriers"], "channel": ses.channel,
+            "lines": lines, "n_lines": res["n_lines"], "n_carriers": res["n_carriers"], "edge": res.get("edge", False),
+            "channel": ses.channel,
             "preprocessing": ses.prep,
             "band_hz": ses.band, "model": res.get("model"), "modulation_sidebands": res.get("modulation"),
             "amplitude": float(ses.amp[i]) if i < ses.amp.size else None, "evidence_db": ev_db}
