@@ -416,8 +416,9 @@ def _explain(ses: _SES, freqs: dict, f1: float, shaft_hz: float, f1_known: bool,
     race comb with its +-1X sidebands at p = 6e-28. Ordering by p-value alone instead fixed that, but
     on 1 s pieces of single channels it let inner-race sideband combs take outer-race lines with their
     +-1X sidebands (the 6203's BPFO + BPFI is 8X, so both combs sit near whole orders and 1 Hz lines
-    cannot tell them apart): 10 wrong calls in 1350 pieces against 4. With the test: 4, and no wrong
-    call on the 135 whole single channels (2 before)."""
+    cannot tell them apart): 10 wrong calls in 1350 pieces against 4. With the test: 4 (3 once a comb
+    at the slip range's edge is not called, ``_accepted``), and no wrong call on the 135 whole single
+    channels (2 before)."""
     _claim_shaft(ses, shaft_hz, f1_known, freqs, contested=shaft)
     ses.results["bearing_cage"] = _claim_cage(ses, freqs["FTF"], n_balls)
     ses.r_base = ses.r.copy()  # what the bearing families compete for (decoys are scored on it)

@@ -271,6 +271,8 @@ def _one_x(f, A, f1):
     (``_harmonic_support``), then the strongest; None when no line stands out. A shaft shows its
     harmonics; an electrical, structural or other machine's line near 1X rarely shows the same comb."""
     df = f[1]
+    m = min(f.size, int(13 * (1 + SPEED_SEARCH) * f1 / df) + 10)   # every floor ring below reaches 12 x fc
+    f, A = f[:m], A[:m]
     k = np.flatnonzero(np.abs(f - f1) <= max(SPEED_SEARCH * f1, 2 * df))
     k = k[(k >= 1) & (k < A.size - 1)]
     k = k[(A[k] >= A[k - 1]) & (A[k] > A[k + 1])]
