@@ -319,6 +319,76 @@ def test_a_speed_declared_10_percent_off_is_corrected_from_the_1x_and_its_harmon
         assert d.top == "bearing_outer_race", factor
 
 
+def test_a_declared_speed_beyond_the_1x_search_is_contradicted_and_no_fault_is_named(shared_data):
+    # declared 15 % slow or 20 % fast (a drive's set point, a nameplate speed): the true 1X (52 dB, all of
+    # 2X-6X) lies outside the +-12 % search, and the old code named inner race at both (confidence 0.72
+    # and 0.81: the bearing lines fell at wrong orders). The record contradicts such a speed: the comb
+    # found elsewhere is reported at the true speed (to 0.2 %: the line's refinement on a 10 s record),
+    # nothing speed-dependent is called, and "none" is a low-confidence answer (nothing was checked)
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.read(shared_data("cwru_fe/OR014@3_0.mat"), fs=12000, unit="g")
+    true = rec.meta["rpm"]
+    for factor in (0.85, 1.2):
+        d = vm.diagnose(rec, rpm=factor * true, bearing="6203-2RS", channel="X309_FE_time")
+        assert "speed_contradicted" in d.flags and "bearing_not_checked" in d.flags, factor
+        assert d.speed["contradicting_rpm"] == pytest.approx(true, rel=0.002), factor
+        assert d.speed["consistent"] is False and d.speed["estimated_rpm"] is None
+        assert d.top == "none" and not d.bearing_checked and d.confidence < 0.5, factor
+        assert "contradicted" in d.reason and f"{true:.0f} rpm" in d.reason
+        assert (d.faults.confidence == 0).all()
+    # the picture marks the comb that contradicts the speed (1X-6X at the speed found)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from vibmeasure.plot import plot_diagnosis
+    ax_s = plot_diagnosis(rec, d)[1]
+    marked = sorted(ln.get_xdata()[0] for ln in ax_s.get_lines() if ln.get_linestyle() == "--")
+    assert marked == pytest.approx([k * d.speed["contradicting_rpm"] / 60 for k in range(1, 7)])
+    plt.close("all")
+    # the command line says so in its first line, and --json carries the flags and the speed found
+    from tests.test_cli import run
+    args = ["diagnose", str(shared_data("cwru_fe/OR014@3_0.mat")), "--fs", "12000", "--unit", "g", "--rpm", "1500",
+            "--bearing", "6203-2RS"]
+    code, out, _ = run(args)
+    assert code == 0 and "NO FAULT CHECKED: the declared speed is contradicted" in out.splitlines()[0]
+    code, out, _ = run(args + ["--json"])
+    js = json.loads(out)
+    assert code == 0 and js["top"] == "none" and "speed_contradicted" in js["flags"]
+    assert js["speed"]["contradicting_rpm"] == pytest.approx(true, rel=0.002)
+    d = vm.diagnose(rec, rpm=true, bearing="6203-2RS", channel="X309_FE_time")
+    assert "speed_contradicted" not in d.flags and d.speed["consistent"] and d.top == "bearing_outer_race"
+
+
+def test_other_shaft_combs_weaker_than_the_1x_do_not_contradict_the_speed():
+    # a looseness machine (1X with 2X-6X) plus another shaft's comb at 1.37 x (a fundamental and four
+    # harmonics): 20 dB under the 1X line it does not stand 10 dB above it; at 30 times the 1X line it
+    # does, but a comb contradicts only a 1X with fewer harmonics, and this 1X has all five (a second
+    # shaft, a belt-driven fan, is no reason to doubt the first)
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.synth.machine(fault="looseness", snr_db=0, seed=3, duration=4.0)
+    x, fs, rpm = rec.data[0], rec.fs, rec.meta["rpm"]
+    win = np.hanning(x.size)
+    A = np.abs(np.fft.rfft((x - x.mean()) * win)) * 2 / win.sum()
+    f = np.fft.rfftfreq(x.size, 1 / fs)
+    a1 = A[np.abs(f - rpm / 60) < 0.5].max()
+    t = np.arange(x.size) / fs
+    for gain, harmonics in ((0.1, 5), (30.0, 5)):
+        y = x + sum(gain * a1 / k * np.sin(2 * np.pi * k * 1.37 * rpm / 60 * t) for k in range(1, harmonics + 1))
+        d = vm.diagnose(vm.Record.from_array(y, fs=fs, names=["acc"], unit="g"), rpm=rpm, bearing="6205-2RS")
+        assert "speed_contradicted" not in d.flags, gain
+        assert d.speed["estimated_rpm"] == pytest.approx(rpm, rel=5e-4), gain
+
+
+def test_a_machine_declared_25_percent_slow_is_contradicted_by_its_own_shaft_comb():
+    # the looseness machine's 1X and its harmonics stand 25 % above the declared speed: no line within
+    # +-12 % carries harmonics, the comb outside does
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.synth.machine(fault="looseness", snr_db=0, seed=3, duration=4.0)
+    d = vm.diagnose(rec, rpm=rec.meta["rpm"] / 1.25, bearing="6205-2RS")
+    assert "speed_contradicted" in d.flags and d.top == "none"
+    assert d.speed["contradicting_rpm"] == pytest.approx(rec.meta["rpm"], rel=5e-4)
+
+
 def test_a_stronger_line_beside_1x_without_harmonics_is_not_taken_for_the_shaft():
     # a looseness machine (1X with harmonics 2X-6X) plus a pure tone 5 % above 1X, 3 x the 1X line's
     # amplitude (another machine's shaft, a structural line): the strongest line near the declared

@@ -436,10 +436,13 @@ def _main_diagnose(args, out, err) -> int:
     else:
         sev = diag.severity
         where = f" in {diag.channel}" if diag.top != "none" else ""
-        scope = " among the shaft-order faults; bearing faults NOT CHECKED" if not diag.bearing_checked else ""
+        contradicted = "speed_contradicted" in diag.flags
+        scope = ("; NO FAULT CHECKED: the declared speed is contradicted (give the measured --rpm or --tach)"
+                 if contradicted else
+                 " among the shaft-order faults; bearing faults NOT CHECKED" if not diag.bearing_checked else "")
         print(f"{args.file}: {diag.top.upper()} (confidence {diag.confidence:.2f}){where}{scope}", file=out)
         print(f"  {diag.reason}", file=out)
-        if not diag.bearing_checked:
+        if not diag.bearing_checked and not contradicted:
             print("  bearing faults: not checked (give --bearing or --bearing-geometry)", file=out)
         est, dec = diag.speed.get("estimated_rpm"), diag.speed.get("declared_rpm")
         if diag.speed.get("source"):

@@ -361,7 +361,8 @@ def plot_diagnosis(rec, diag, *, axes=None):
     if ses is not None:
         _plot_ses(ax_e, ses, diag, colors)
     else:
-        ax_e.text(0.5, 0.5, "bearing faults not checked (no bearing given)", ha="center", va="center",
+        why = ("the declared speed is contradicted" if "speed_contradicted" in diag.flags else "no bearing given")
+        ax_e.text(0.5, 0.5, f"bearing faults not checked ({why})", ha="center", va="center",
                   transform=ax_e.transAxes)
         ax_e.set_axis_off()
     if ax_k is not None:
@@ -382,7 +383,14 @@ def plot_diagnosis(rec, diag, *, axes=None):
     ax_s.set_xlabel("frequency [Hz]")
     ax_s.set_ylabel(f"amplitude [{s.unit or '-'}]")
     ax_s.set_title(f"spectrum of {rec.names[0]} with shaft orders 1X..10X (1X = {f1:.2f} Hz)", fontsize=9)
-    if "speed_inconsistent" in diag.flags or not diag.speed.get("consistent", True):
+    other = diag.speed.get("contradicting_rpm")
+    if other is not None:   # the shaft comb that contradicts the declared speed, where it stands
+        for k in range(1, 7):
+            ax_s.axvline(k * other / 60, color="C3", lw=0.8, ls="--")
+        ax_s.text(0.5, 0.9, f"WARNING: the declared {diag.speed['declared_rpm']:g} rpm is contradicted: a shaft comb "
+                  f"stands at {other:.0f} rpm (red); no fault was looked for", transform=ax_s.transAxes,
+                  ha="center", color="C3", fontsize=9, fontweight="bold")
+    elif "speed_inconsistent" in diag.flags or not diag.speed.get("consistent", True):
         ax_s.text(0.5, 0.9, "WARNING: the speed check failed (see the diagnosis flags)", transform=ax_s.transAxes,
                   ha="center", color="C3", fontsize=9, fontweight="bold")
     elif "order_tracked" in diag.flags or "speed_varies" in diag.flags:
