@@ -319,6 +319,14 @@ def test_a_speed_declared_10_percent_off_is_corrected_from_the_1x_and_its_harmon
         assert d.top == "bearing_outer_race", factor
 
 
+def _one_x_amplitude(x, fs, rpm):
+    """The 1X line's amplitude in the Hann spectrum of x (as diagnose measures it)."""
+    win = np.hanning(x.size)
+    A = np.abs(np.fft.rfft((x - x.mean()) * win)) * 2 / win.sum()
+    f = np.fft.rfftfreq(x.size, 1 / fs)
+    return A[np.abs(f - rpm / 60) < 0.5].max()
+
+
 def test_a_declared_speed_beyond_the_1x_search_is_contradicted_and_no_fault_is_named(shared_data):
     # declared 15 % slow or 20 % fast (a drive's set point, a nameplate speed): the true 1X (52 dB, all of
     # 2X-6X) lies outside the +-12 % search, and the old code named inner race at both (confidence 0.72
@@ -367,10 +375,7 @@ def test_other_shaft_combs_weaker_than_the_1x_do_not_contradict_the_speed():
     warnings.simplefilter("ignore", vm.QualityWarning)
     rec = vm.synth.machine(fault="looseness", snr_db=0, seed=3, duration=4.0)
     x, fs, rpm = rec.data[0], rec.fs, rec.meta["rpm"]
-    win = np.hanning(x.size)
-    A = np.abs(np.fft.rfft((x - x.mean()) * win)) * 2 / win.sum()
-    f = np.fft.rfftfreq(x.size, 1 / fs)
-    a1 = A[np.abs(f - rpm / 60) < 0.5].max()
+    a1 = _one_x_amplitude(x, fs, rpm)
     t = np.arange(x.size) / fs
     for gain, harmonics in ((0.1, 5), (30.0, 5)):
         y = x + sum(gain * a1 / k * np.sin(2 * np.pi * k * 1.37 * rpm / 60 * t) for k in range(1, harmonics + 1))
@@ -397,10 +402,7 @@ def test_a_stronger_line_beside_1x_without_harmonics_is_not_taken_for_the_shaft(
     warnings.simplefilter("ignore", vm.QualityWarning)
     rec = vm.synth.machine(fault="looseness", snr_db=0, seed=1, duration=4.0)
     x, fs, rpm = rec.data[0], rec.fs, rec.meta["rpm"]
-    win = np.hanning(x.size)
-    A = np.abs(np.fft.rfft((x - x.mean()) * win)) * 2 / win.sum()
-    f = np.fft.rfftfreq(x.size, 1 / fs)
-    a1 = A[np.abs(f - rpm / 60) < 0.5].max()
+    a1 = _one_x_amplitude(x, fs, rpm)
     y = x + 3 * a1 * np.sin(2 * np.pi * 1.05 * rpm / 60 * np.arange(x.size) / fs)
     d = vm.diagnose(vm.Record.from_array(y, fs=fs, names=["acc"], unit="g"), rpm=rpm, bearing="6205-2RS")
     assert d.speed["estimated_rpm"] == pytest.approx(rpm, rel=5e-4)

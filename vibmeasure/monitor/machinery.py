@@ -322,8 +322,6 @@ def _other_shaft(f, A, f1, found, snr1):
     m = min(f.size, int(13 * OTHER_SHAFT[1] * f1 / df) + 10)
     f, A = f[:m], A[:m]
     k = np.flatnonzero((f >= OTHER_SHAFT[0] * f1) & (f <= OTHER_SHAFT[1] * f1) & (np.abs(f - f1) > SPEED_SEARCH * f1))
-    k = k[(k >= 1) & (k < A.size - 1)]
-    k = k[(A[k] >= A[k - 1]) & (A[k] > A[k + 1])]
     need = max(LINE_DB, snr1 + OTHER_SHAFT_DB)
     # the exact test (``_line``: over the median of 0-2 x the line's frequency) runs on the lines within
     # 20 dB of the need over the median of 0-4 x f1: on the development records and their 1 s pieces,
@@ -332,11 +330,7 @@ def _other_shaft(f, A, f1, found, snr1):
     floor = np.median(A[1: max(3, int(4 * f1 / df))])
     k = k[A[k] >= floor * 10 ** ((need - 20) / 20)]
     best = None
-    for i in k:
-        db = _line(f, A, f[i], 0.6 * df, f[i] + 5 * df)[2]
-        if db < need:
-            continue
-        fc = _refine(f, A, f[i])
+    for fc, db in _lines_standing(f, A, k, need):
         if found is not None:
             if any(abs(fc / (found[0] * q) - 1) < 0.01 for q in (2, 3, 4, 1 / 2, 1 / 3, 1 / 4, 3 / 2, 2 / 3)):
                 continue
@@ -346,6 +340,16 @@ def _other_shaft(f, A, f1, found, snr1):
         if h >= OTHER_SHAFT_HARMONICS and (found is None or h > found[2]) and (best is None or (h, db) > best[1:]):
             best = (fc, h, db)
     return best
+
+
+def _lines_standing(f, A, k, need):
+    """(refined frequency, height in dB) of each local maximum among the bins k that stands ``need`` dB
+    above its local floor."""
+    k = k[(k >= 1) & (k < A.size - 1)]
+    for i in k[(A[k] >= A[k - 1]) & (A[k] > A[k + 1])]:
+        db = _line(f, A, f[i], 0.6 * f[1], f[i] + 5 * f[1])[2]
+        if db >= need:
+            yield _refine(f, A, f[i]), db
 
 
 def _harmonic_support(f, A, fc) -> int:
@@ -365,14 +369,8 @@ def _one_x(f, A, f1):
     m = min(f.size, int(13 * (1 + SPEED_SEARCH) * f1 / df) + 10)   # every floor ring below reaches 12 x fc
     f, A = f[:m], A[:m]
     k = np.flatnonzero(np.abs(f - f1) <= max(SPEED_SEARCH * f1, 2 * df))
-    k = k[(k >= 1) & (k < A.size - 1)]
-    k = k[(A[k] >= A[k - 1]) & (A[k] > A[k + 1])]
     best = None
-    for i in k:
-        snr = _line(f, A, f[i], 0.6 * df, f[i] + 5 * df)[2]
-        if snr < LINE_DB:
-            continue
-        fc = _refine(f, A, f[i])
+    for fc, snr in _lines_standing(f, A, k, LINE_DB):
         cand = (fc, snr, _harmonic_support(f, A, fc))
         if best is None or (cand[2], cand[1]) > (best[2], best[1]):
             best = cand
