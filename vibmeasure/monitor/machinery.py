@@ -746,6 +746,11 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     ``order_tracked``. Without speed information, a 1X that drifts along a curve (flag
     ``speed_varies``) gives the speed profile instead (``speed["source"]`` "1X line"). The ISO
     severity is taken from the record as measured.
+
+    The 1X is looked for within 12 % of ``rpm``. When the record contradicts the declared speed (a
+    shaft comb stands elsewhere, 10 dB above the 1X candidate and with more harmonics, in any channel),
+    the flag is ``speed_contradicted``, ``speed["contradicting_rpm"]`` says where the comb stands, and
+    no shaft-order or bearing fault is looked for ("none", ``bearing_checked`` False).
     """
     from . import shaft_faults as sf
     rec = as_record(rec, fs=fs)
