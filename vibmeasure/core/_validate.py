@@ -174,7 +174,8 @@ def clean_signal(rec: Record, idx: int, *, min_samples: int = 16, what: str = "r
         raise ParameterError(f"{what} channel {name!r} has {int(bad.sum())} NaN/inf samples (first at index {i}, "
                              f"t={i / rec.fs:g} s); the rule is finite data: repair or cut the record first")
     if np.ptp(x) == 0:
-        raise ParameterError(f"{what} channel {name!r} is constant ({x[0]!r}): there is no vibration to analyse")
+        raise ParameterError(f"{what} channel {name!r} is constant (every sample {float(x[0]):g}): there is no "
+                             "vibration to analyse")
     return x
 
 

@@ -276,8 +276,9 @@ def _speed(job: _Job, f, A):
 
 
 # A declared speed further off than SPEED_SEARCH finds no 1X, or a wrong line, and the bearing lines fall at
-# wrong orders: the 53 development records declared at 0.88 x their speed gave 16 wrong calls. The record
-# contradicts such a speed when a shaft comb stands elsewhere (OTHER_SHAFT x the declared speed): a line
+# wrong orders: the 53 development records declared at 0.88 x their speed gave 16 wrong calls (first
+# channel as the primary one). The record contradicts such a speed when a shaft comb stands elsewhere
+# (OTHER_SHAFT x the declared speed): a line
 # at least OTHER_SHAFT_DB above the window's 1X (or the level there when none stands out) with at least
 # OTHER_SHAFT_HARMONICS of its harmonics 2X-6X, more than that 1X has, and no harmonic or sub-harmonic
 # of it. Measured (benchmarks/diagnosis_robustness.py, and scratch sweeps of every channel): at the
