@@ -26,9 +26,10 @@ Pipeline for one record (``bearing_evidence``):
    with its modulation sidebands (+-1X: the defect turns through the load zone; +-FTF: the ball
    travels with the cage) and a line at one of its first three harmonics: a bare comb near BPFI or
    2xBSF is not called. No family is called from lines at even harmonics alone (a comb at twice its
-   fundamental, which is no frequency of this bearing). A family that explains lines best but fails those conditions still claims
-   them (it is not called there): the sidebands k x BPFI - k x 1X of an inner race whose carriers are
-   weak make a comb at 3.947 X, inside the +-2 % of the 6203's 2 x BSF (3.987 X).
+   fundamental, which is no frequency of this bearing). A family that explains lines best but fails
+   those conditions still claims them (it is not called there): the sidebands k x BPFI - k x 1X of an
+   inner race whose carriers are weak make a comb at 3.947 X, inside the +-2 % of the 6203's 2 x BSF
+   (3.987 X).
 4. test: a family's statistic is the sum of r over its comb (harmonics 1-3 and sidebands) at the
    common slip (within +-2 %) that maximises it; under noise that sum is Gamma(n_terms) distributed,
    and the p-value is multiplied by the number of slip positions, bins and sub-models searched
