@@ -235,6 +235,60 @@ def test_a_comb_of_even_harmonics_only_is_twice_the_fundamental_and_not_that_fau
             assert abs(b6205.frequencies(f1)["BPFO"] * 2 / za.frequencies(f1)["BPFO"] - 1) < 0.02
 
 
+def test_step_is_the_spacing_of_the_comb_the_standing_harmonics_make():
+    # in multiples of the fundamental; up to 1 the lines pin the fundamental itself
+    assert bf._step([1.0]) == 1.0 and bf._step([1.0, 2.0, 3.0]) == 1.0 and bf._step([2.0, 3.0]) == 1.0
+    assert bf._step([2.0, 4.0]) == 2.0 and bf._step([3.0]) == 3.0 and bf._step([5.0]) == 5.0
+    # the ball family's BSF sub-model (0.5, 1, 1.5 x 2xBSF): BSF and 2xBSF are its own lines
+    assert bf._step([0.5]) == 0.5 and bf._step([0.5, 1.5]) == 0.5 and bf._step([1.5]) == 1.5
+    assert bf._step([]) == 1.0
+
+
+def test_a_lone_third_harmonic_with_its_sidebands_is_no_comb_of_that_fault():
+    # synthetic: an inner-race fault of a 25-ball bearing whose BPFI stands 0.5 % above three times the
+    # 6205's (16.32 X against 5.415 X), read with a 6205 declared: the 6205's inner-race comb shows its
+    # 3rd harmonic with +-1X sidebands and nothing at the 1st or 2nd. Called 6205 inner race (p ~ 1e-14)
+    # on every seed before the rule
+    f1 = 1797.0 / 60
+    b6205 = vm.BEARINGS["6205-2RS"]
+    ratio = 3 * b6205.frequencies(f1)["BPFI"] / f1 * 1.005
+    odd = vm.Bearing(25, 10.0 * (2 * ratio / 25 - 1), 10.0, 0.0)   # BPFI = n/2 (1 + d/D) x 1X
+    assert abs(odd.frequencies(f1)["BPFI"] / (3 * b6205.frequencies(f1)["BPFI"]) - 1.005) < 1e-9
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        for seed in range(2):
+            rec = vm.synth.machine(fault="bearing_inner_race", bearing=odd, snr_db=0, seed=600 + seed,
+                                   duration=6.0)
+            assert vm.diagnose(rec, bearing=odd).top == "bearing_inner_race"
+            d = vm.diagnose(rec, bearing="6205-2RS")
+            assert d.top == "none", d.reason
+            row = d.faults.set_index("fault").loc["bearing_inner_race"]
+            assert row.p_value < 1e-10   # strong, and it would pass every other rule
+            standing = {h["harmonic"] for h in row.harmonics if h["db"] >= 10 * np.log10(bf.R_LINE)}
+            assert standing == {3.0}
+            assert "multiples of its harmonic 3" in row.not_called
+
+
+def test_a_real_outer_race_read_with_the_other_ends_bearing_is_not_its_inner_race(shared_data):
+    # CWRU OR021@3_1: the fan-end 6203's outer-race fault. Read with the drive end's 6205, the 6203's
+    # 5 x BPFO (at +0.4 % slip) with its +1X and +2X sidebands stands as the 6205's 3 x BPFI with its
+    # +-1X (453, 483, 512 Hz, 10-18 dB); nothing at its 1st or 2nd harmonic. Called 6205 inner race
+    # (p = 6e-34) before the rule
+    rec = vm.read(shared_data("cwru_fe/OR021@3_1.mat"), fs=12000, unit="g")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        d = vm.diagnose(rec, bearing="6205-2RS")
+    assert d.top == "none", d.reason
+    row = d.faults.set_index("fault").loc["bearing_inner_race"]
+    assert row.p_value < 1e-20
+    standing = [h for h in row.harmonics if h["db"] >= 10 * np.log10(bf.R_LINE)]
+    assert {h["harmonic"] for h in standing} == {3.0} and len(standing) == 3
+    f1 = rec.meta["rpm"] / 60
+    lower = next(h["hz"] for h in standing if h["sideband"] == -1)
+    assert abs(lower / (5 * vm.BEARINGS["6203-2RS"].frequencies(f1)["BPFO"]) - 1) < 0.01   # the 6203's line
+    assert "multiples of its harmonic 3" in row.not_called
+
+
 # --- real recordings -----------------------------------------------------------------------------------
 
 TRUTH = {"I": "bearing_inner_race", "O": "bearing_outer_race", "B": "bearing_ball"}
