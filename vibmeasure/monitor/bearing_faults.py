@@ -28,10 +28,9 @@ Pipeline for one record (``bearing_evidence``):
    2xBSF is not called. No family is called from lines that stand only at multiples of one of its
    harmonics (``_step``): lines at harmonics 2 and 4 alone are a comb at twice its fundamental, a 3rd
    harmonic with its +-1X sidebands alone one at three times it, and neither is a frequency of this
-   bearing. A family that explains lines best but fails
-   those conditions still claims them (it is not called there): the sidebands k x BPFI - k x 1X of an
-   inner race whose carriers are weak make a comb at 3.947 X, inside the +-2 % of the 6203's 2 x BSF
-   (3.987 X).
+   bearing. A family that explains lines best but fails those conditions still claims them (it is not
+   called there): the sidebands k x BPFI - k x 1X of an inner race whose carriers are weak make a comb
+   at 3.947 X, inside the +-2 % of the 6203's 2 x BSF (3.987 X).
 4. test: a family's statistic is the sum of r over its comb (harmonics 1-3 and sidebands) at the
    common slip (within +-2 %) that maximises it; under noise that sum is Gamma(n_terms) distributed,
    and the p-value is multiplied by the number of slip positions, bins and sub-models searched
