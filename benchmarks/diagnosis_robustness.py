@@ -1,5 +1,5 @@
 """Machine diagnosis on the development records when they come in another shape: resampled, low-passed,
-with an interference tone, with added noise, cut shorter, with a wrong declared speed (1, 5 and 10 %, and
+with an interference tone, with mains pickup (a 50 or 60 Hz comb), with added noise, cut shorter, with a wrong declared speed (1, 5 and 10 %, and
 15, 20 and 30 %, beyond the 1X search, where the honest answer is "none": the record contradicts the speed), one
 channel alone (whole, and in 1 s pieces). Held-out recordings come from other rigs and converters, often with one sensor; a method
 that generalises keeps its answers (or says "none") and does not start making wrong calls.
@@ -44,6 +44,16 @@ def _tone(frac, amp):
     return f
 
 
+def _mains(line_hz, amp):
+    """Mains pickup: a comb at the line frequency and its harmonics 1-6 (amplitudes 1/k), amp x each
+    channel's RMS in all."""
+    def f(rec, rpm):
+        t = np.arange(rec.n_samples) / rec.fs
+        hum = sum(np.cos(2 * np.pi * k * line_hz * t + k) / k for k in range(1, 7))
+        return _rebuilt(rec, rec.data + amp * rec.data.std(axis=1, keepdims=True) * hum / hum.std()), rpm
+    return f
+
+
 def _piece(k, m):
     def f(rec, rpm):
         n = rec.n_samples // m
@@ -74,6 +84,9 @@ VARIANTS = {
     "low-passed at 0.4 x Nyquist": _lowpass(0.4),
     "tone 20 dB above the RMS at 0.4 fs": _tone(0.4, 10.0),
     "tone 30 dB above the RMS at 0.33 fs": _tone(0.33, 30.0),
+    # mains pickup: taken for a shaft, such a comb contradicted the declared speed (nothing checked)
+    "mains 50 Hz comb at 0.3 x the RMS": _mains(50.0, 0.3),
+    "mains 60 Hz comb at 0.3 x the RMS": _mains(60.0, 0.3),
     "noise at the record's RMS": lambda rec, rpm: (_rebuilt(rec, rec.data + np.random.default_rng(0).normal(
         size=rec.data.shape) * rec.data.std(axis=1, keepdims=True)), rpm),
     "rpm declared 1 % high": lambda rec, rpm: (rec, 1.01 * rpm),
