@@ -444,6 +444,19 @@ def test_a_mains_line_near_the_declared_speed_is_not_taken_for_the_1x():
         assert "speed_corrected" not in d.flags and d.top == fault, d.reason
 
 
+def test_a_mains_line_is_no_sub_harmonic_of_the_shaft():
+    # a looseness machine at 2100 rpm (0.5X sub-harmonics at 17.5 and 52.5 Hz) with 60 Hz pickup: the
+    # 60 Hz line stood within 2 lines of 7/4 X (61.25 Hz on a 1.28 s record), the third line at a
+    # quarter-order, and the record was taken to be sampled at 4 x its rate (speed_inconsistent)
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    for seed in range(2):
+        rec = vm.synth.machine(fault="looseness", rpm=2100, fs=25600, duration=1.28, bearing="UER204", snr_db=0,
+                               seed=800 + seed)
+        d = vm.diagnose(_with_mains(rec, 60.0), rpm=2100, bearing="UER204")
+        assert "speed_inconsistent" not in d.flags and d.speed["fs_ratio"] == 1
+        assert d.top == "looseness", d.reason
+
+
 def test_a_stronger_line_beside_1x_without_harmonics_is_not_taken_for_the_shaft():
     # a looseness machine (1X with harmonics 2X-6X) plus a pure tone 5 % above 1X, 3 x the 1X line's
     # amplitude (another machine's shaft, a structural line): the strongest line near the declared

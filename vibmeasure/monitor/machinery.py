@@ -237,8 +237,10 @@ def _speed(job: _Job, f, A):
                              "rpm: the measured speed is used")
             job.flags.append("speed_corrected")
     for r in (4, 2):
-        hits = [_line(f, A, k * f1 / r, max(2 * df, 0.01 * k * f1 / r), 0.5 * f1 / r)[2] >= LINE_DB
-                for k in range(1, 2 * r) if k % r]
+        # a mains line is no sub-harmonic (a 60 Hz line stood for 7/4 X of a 2100 rpm looseness machine)
+        hits = [db >= LINE_DB and not _at_mains(fk, df, job.mains)
+                for fk, _, db in (_line(f, A, k * f1 / r, max(2 * df, 0.01 * k * f1 / r), 0.5 * f1 / r)
+                                  for k in range(1, 2 * r) if k % r)]
         if r == 4 and sum(hits) >= 3 or r == 2 and all(hits) and snr1 < LINE_DB:
             speed.update(consistent=False, fs_ratio=r, note=(
                 f"lines at {1 / r:g}X, ... fit a shaft speed of {job.rpm:g} rpm only if fs is {r}x the declared "
