@@ -123,6 +123,11 @@ def test_bad_input():
                     rpm=1797)
     with pytest.raises(vm.ParameterError, match="machine_group"):
         vm.diagnose(rec, machine_group=3)
+    # line_frequency names the mains (the electrical check and the lines not taken for a shaft)
+    for bad, rule in ((0, "finite and > 0"), (np.nan, "finite and > 0"), (True, "a number"), ("50", "a number"),
+                      (1e7, "below the Nyquist")):
+        with pytest.raises(vm.ParameterError, match=f"line_frequency=.*{rule}"):
+            vm.diagnose(rec, bearing="6205-2RS", line_frequency=bad)
 
 
 def test_twice_line_frequency():

@@ -787,7 +787,14 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     job = _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band, skip)
     job.prewhitening = _check_prewhitening(prewhitening)
     if line_frequency is not None:
-        job.mains = (positive(line_frequency, "line_frequency"),)
+        if isinstance(line_frequency, (bool, str)):
+            raise ParameterError(f"line_frequency={line_frequency!r} must be the supply's frequency in Hz, a number "
+                                 "(50 or 60 on public grids)")
+        lf = positive(line_frequency, "line_frequency")
+        if 2 * lf >= job.fs / 2:
+            raise ParameterError(f"line_frequency={lf:g} Hz: twice it ({2 * lf:g} Hz) must lie below the Nyquist "
+                                 f"frequency ({job.fs / 2:g} Hz) for the electrical check")
+        job.mains = (lf,)
     measured = job
     if tracked is not None:
         job, note = _order_tracked_job(job, tracked, band)
