@@ -318,6 +318,19 @@ def _claim_shaft(ses: _SES, f1: float, f1_known: bool, freqs: dict | None = None
             _mask(ses, hz)
 
 
+def _claim_artefact(ses: _SES, hz: float):
+    """Every harmonic of a comb the recording chain made at an exactly known frequency (spikes every P
+    samples, repaired: what the repair cannot restore repeats every P samples) is claimed, standing or
+    not; a bearing line that falls within a bin of one is lost with it."""
+    df = ses.freq[1]
+    for k in range(1, int((ses.n_valid - 2) * df / hz) + 1):
+        i = int(round(k * hz / df))
+        if 2 <= i < ses.n_valid - 2 and ses.r[i - 1: i + 2].max() > 2.0:
+            _mask(ses, i * df)
+        elif 2 <= i < ses.n_valid - 2:
+            ses.r[i - 1: i + 2] = 0.0
+
+
 def _claim_cage(ses: _SES, ftf: float, n_balls: int) -> dict | None:
     """The cage comb (FTF harmonics that are not BPFO's, which is n_balls x FTF): claimed when
     significant. Cage-rate modulation is common on healthy bearings; it is reported, not called."""
@@ -605,8 +618,11 @@ def _fused(spectra: list) -> list:
 # --- the whole record -------------------------------------------------------------------------------
 
 def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: int, *, band=None,
-                     shaft_hz: float | None = None, f1_known: bool = True, whitening=("cepstral",)) -> dict:
-    """Evidence per bearing family over every channel in ``signals`` (name -> array).
+                     shaft_hz: float | None = None, f1_known: bool = True, whitening=("cepstral",),
+                     artefact_hz=()) -> dict:
+    """Evidence per bearing family over every channel in ``signals`` (name -> array). ``artefact_hz``:
+    fundamentals of combs the recording chain made (spikes every P samples: fs / P), whose lines are
+    claimed before anything else.
 
     Returns {"families": {name: summary}, "spectra": [_SES], "kurtogram": Kurtogram of the first channel,
     "n_spectra": int, "measured_top_hz": {channel: upper edge of the band it measures}}. Each summary
@@ -624,6 +640,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     shaft = any(_shaft_shows(s, shaft_hz or f1, f1_known, freqs) for s in spectra)
     spectra += _fused(spectra)
     for s in spectra:
+        for g in artefact_hz:
+            _claim_artefact(s, g)
         _explain(s, freqs, f1, shaft_hz or f1, f1_known, n_balls, shaft=shaft)
     n_sp = len(spectra)
     if not n_sp:

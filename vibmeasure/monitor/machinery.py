@@ -16,7 +16,7 @@ from scipy import fft as _sfft
 
 from ..core import units as _units
 from ..core._validate import as_record, clean_signal, memory_guard, positive, response_channel
-from ..core.errors import ParameterError
+from ..core.errors import ParameterError, warn_quality
 from ..models.bearing import Bearing, Gear, bearing_from
 from .bearing_faults import FAMILIES, bearing_evidence
 from .calibration import NONE_BEARING, NONE_SHAFT, UNCHECKED, calibrated
@@ -99,6 +99,7 @@ class _Job:
     prewhitening: tuple = ("cepstral",)
     bearing_weak: bool = False   # every channel's measured band ends below the demodulation region
     mains: tuple = (50.0, 60.0)  # the line frequencies whose lines are electrical (``_at_mains``)
+    quality: dict = field(default_factory=dict)   # channel -> damage found in its samples (``_damage``)
 
 
 def _line(freq, values, f, tol, floor_halfwidth):
@@ -114,10 +115,13 @@ def _line(freq, values, f, tol, floor_halfwidth):
 
 # --- prepare ---------------------------------------------------------------------------------------
 
-def _accel(rec, i, flags):
-    """Channel i as float64, in m/s^2 when its unit is a known acceleration unit."""
+def _accel(rec, i, flags, quality=None):
+    """Channel i as float64, in m/s^2 when its unit is a known acceleration unit, with its isolated
+    spikes repaired (``signal.quality``); ``quality`` (channel -> findings) collects what the samples
+    show of the recording chain's damage: spikes, dropouts, saturation."""
     x = clean_signal(rec, i, min_samples=256)
     ch = rec.channels[i]
+    x = _damage(x, rec.fs, ch.name, flags, {} if quality is None else quality)
     if ch.unit and ch.quantity == "acceleration":
         x = _units.convert(x, ch.unit, "m/s^2")
     elif "unit_unknown" not in flags:
@@ -125,6 +129,54 @@ def _accel(rec, i, flags):
     from ..core._validate import check_range
     check_range(x, what=f"channel {ch.name!r}")
     return x
+
+
+def _damage(x, fs, name, flags, quality):
+    """The channel with its isolated spikes replaced (they are no vibration, and a spike train makes a
+    comb in the envelope spectrum); dropouts and saturation are only reported: the samples they hide
+    cannot be rebuilt."""
+    from ..signal import quality as q
+    found = {}
+    idx = q.isolated_spikes(x)
+    if idx.size:
+        x = q._repair(x, idx)
+        found["spikes_removed"] = int(idx.size)
+        grid = q._grid(idx)
+        if grid is not None:   # a spike every P samples: the repairs' own errors make a comb at fs / P
+            found["spike_interval_samples"] = grid[1]
+    runs = q.flat_runs(x, fs)
+    if runs:
+        found["dropouts"] = len(runs)
+        found["dropout_seconds"] = float(sum(e - s for s, e in runs) / fs)
+    share = q.clipped_share(x)
+    if share > 0:
+        found["saturated_share"] = share
+    if found:
+        quality[name] = found
+        for flag, key in (("spikes_removed", "spikes_removed"), ("dropouts", "dropouts"),
+                          ("saturated", "saturated_share")):
+            if key in found and flag not in flags:
+                flags.append(flag)
+    return x
+
+
+def _quality_note(quality: dict) -> str:
+    """One sentence per channel on the damage found in its samples, for the reason and the warning."""
+    out = []
+    for name, f in quality.items():
+        parts = []
+        if "spikes_removed" in f:
+            n = f["spikes_removed"]
+            parts.append(f"{n} isolated spike{'s' * (n > 1)} (single samples far from both neighbours) replaced"
+                         + (f", one every {f['spike_interval_samples']} samples (its comb in the envelope "
+                            "spectrum is not taken for a bearing's)" if "spike_interval_samples" in f else ""))
+        if "dropouts" in f:
+            parts.append(f"{f['dropouts']} dropout{'s' * (f['dropouts'] > 1)} (runs of equal samples, "
+                         f"{f['dropout_seconds']:.3g} s in all)")
+        if "saturated_share" in f:
+            parts.append(f"saturated: {100 * f['saturated_share']:.2g} % of the samples sit at its extremes")
+        out.append(f"channel {name!r}: " + ", ".join(parts))
+    return "; ".join(out)
 
 
 def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band, skip=()) -> _Job:
@@ -158,18 +210,20 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
         gear = Gear(gear)
     _check_nyquist(rec.fs, f1, bearing, gear)
     flags: list = []
-    a = _accel(rec, idx, flags)
+    quality: dict = {}
+    a = _accel(rec, idx, flags, quality)
     if channels is None:
         chosen = [i for i, c in enumerate(rec.channels) if c.quantity not in ("force", "time") and i not in skip]
     else:
         chosen = [rec.index(c) for c in ([channels] if isinstance(channels, (str, int)) else channels)]
     if idx not in chosen:
         chosen.insert(0, idx)
-    signals = {rec.channels[i].name: (a if i == idx else _accel(rec, i, flags)) for i in chosen}
+    signals = {rec.channels[i].name: (a if i == idx else _accel(rec, i, flags, quality)) for i in chosen}
     if band is not None:
         from ..core._validate import check_band
         band = check_band(band, rec.fs)
-    return _Job(rec.fs, rpm, rec.channels[idx].name, a, signals, bearing, gear, group, found, band, flags)
+    return _Job(rec.fs, rpm, rec.channels[idx].name, a, signals, bearing, gear, group, found, band, flags,
+                quality=quality)
 
 
 def _check_prewhitening(value) -> tuple:
@@ -623,8 +677,13 @@ def _bearing_rows(job: _Job, f1: float, speed: dict):
         return [], None
     freqs = job.bearing.frequencies(f1)
     shaft = f1 / speed.get("fs_ratio", 1)
+    # glitches at a fixed interval of samples stand at a fixed frequency only while the record keeps its
+    # sampling (after angular resampling the repaired comb smears)
+    glitch = () if "order_tracked" in job.flags else tuple(sorted(
+        {job.fs / f["spike_interval_samples"] for f in job.quality.values() if "spike_interval_samples" in f}))
     ev = bearing_evidence(job.signals, job.fs, f1, freqs, job.bearing.n_balls, band=job.band,
-                          shaft_hz=shaft, f1_known=speed["estimated_rpm"] is not None, whitening=job.prewhitening)
+                          shaft_hz=shaft, f1_known=speed["estimated_rpm"] is not None, whitening=job.prewhitening,
+                          artefact_hz=glitch)
     rows = []
     for name, s in ev["families"].items():
         lines = [f"{ln['hz']:.1f} Hz {ln['db']:.0f} dB" for ln in s["lines"] if ln["r"] >= 6.0]
@@ -850,6 +909,11 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     if job.bearing is None or contradicted:
         job.flags.append("bearing_not_checked")
     extras = {"also": also, "primary": job.primary, "score": score, "confidence_kind": kind}
+    if job.quality:
+        note = _quality_note(job.quality)
+        reason += "; data: " + note
+        extras["data_quality"] = {k: dict(v) for k, v in job.quality.items()}
+        warn_quality("diagnose: " + note, stacklevel=4)
     if parts is not None:
         extras["score_parts"] = parts
     env_band = ()

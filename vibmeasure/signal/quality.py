@@ -1,0 +1,181 @@
+"""Damage a recording chain leaves in the samples: isolated spikes, flat runs (dropouts), clipping.
+
+A converter's buffer boundary, a loose connector or a switching transient can put single samples far
+from their neighbours. No accelerometer behind an anti-alias filter makes such a sample: a structure's
+response and the sensor's rings over several samples, so a real impact moves its neighbours too. The
+envelope analysis cannot tell them apart: a spike is broadband, the kurtogram picks it as the most
+impulsive band, and spikes at a fixed interval make a comb in the envelope spectrum (every 1024
+samples at 12 kHz is 11.72 Hz, within 2 % of the 6205's cage frequency, whose 9th harmonic is BPFO).
+Measured on the 53 development fault records (``benchmarks/diagnosis_robustness.py``): 30 x the RMS
+every 1024 samples gave 7 wrong calls, five random ones a second left 5 of 39 right answers.
+
+``isolated_spikes`` finds them: a sample whose departure from the running median of 7 (the residual)
+is both ``SPIKE_SIGMA`` times the residual's robust spread (MAD) and ``SPIKE_ISOLATION`` times the
+largest residual of the ``SPIKE_CONTEXT`` samples on each side. On every channel of the 57 development
+recordings (CWRU at 12 kHz, MFPT at 48.8 kHz, impacts of faulty bearings included) the largest such
+ratio is 2.96, and no sample is found. ``despike`` replaces each by the mean of its two neighbours.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core._validate import as_record
+from ..core.errors import ParameterError, warn_quality
+from ..core.record import Record
+
+__all__ = ["despike", "isolated_spikes", "flat_runs", "clipped_share"]
+
+SPIKE_SIGMA = 10.0      # residual of a spike over the residual's robust spread (1.4826 MAD)
+SPIKE_ISOLATION = 4.0   # ... and over every other residual within SPIKE_CONTEXT samples
+SPIKE_CONTEXT = 16
+SPIKE_LEVEL = 3.0       # ... and this many times the record's own robust spread (1.4826 MAD of the samples)
+SPIKE_PASSES = 3        # passes, each on the record with the spikes found before repaired
+GRID_MIN = 5            # spikes on one grid of a fixed interval: at least this many ...
+GRID_SHARE = 0.8        # ... with this share of the intervals between them whole multiples of it
+GRID_SIGMA = 3.0        # on such a grid, a residual this far out (robust sigmas) is a spike too
+FLAT_RUN = 8            # a dropout: this many equal samples or more in a row (and at least 0.5 ms) ...
+FLAT_SECONDS = 5e-4
+
+
+def _residual(x: np.ndarray) -> tuple[np.ndarray, float]:
+    from scipy.ndimage import median_filter
+    r = x - median_filter(x, size=7, mode="reflect")
+    return r, 1.4826 * float(np.median(np.abs(r - np.median(r))))
+
+
+def isolated_spikes(x, *, sigma: float = SPIKE_SIGMA, isolation: float = SPIKE_ISOLATION) -> np.ndarray:
+    """Indices of the single samples that stand far from both neighbours and from every sample near
+    them (see the module's docstring); an empty array when there are none."""
+    x = np.asarray(x, dtype=np.float64)
+    if x.ndim != 1 or x.size < 2 * SPIKE_CONTEXT + 1:
+        return np.zeros(0, np.int64)
+    # two spikes within SPIKE_CONTEXT of each other hide each other: once the first pass has repaired
+    # one, the next finds the other (50 random spikes a second at 12 kHz: 90 % found in one pass)
+    found = np.zeros(0, np.int64)
+    for _ in range(SPIKE_PASSES):
+        new = _spikes_once(_repair(x, found) if found.size else x, sigma, isolation)
+        new = np.setdiff1d(new, found)
+        if not new.size:
+            break
+        found = np.union1d(found, new)
+    return found
+
+
+def _spikes_once(x: np.ndarray, sigma: float, isolation: float) -> np.ndarray:
+    r, s = _residual(x)
+    a = np.abs(r)
+    if s == 0.0:   # over half the residuals are 0 (a flat or coarsely quantised record)
+        s = float(np.mean(a)) or 1.0
+    # far out against the residual's spread, and against the record itself: on a smooth, oversampled
+    # record (a slow ring-down) the residual's spread is tiny and a wiggle of 0.3 % of the RMS is no spike
+    level = SPIKE_LEVEL * 1.4826 * float(np.median(np.abs(x - np.median(x))))
+    cand = np.flatnonzero((a > sigma * s) & (a > level))
+    if cand.size == 0:
+        return np.zeros(0, np.int64)
+    # a candidate whose neighbour is one too is no single sample; two single ones within SPIKE_CONTEXT
+    # samples do not hide each other (two spikes close together), but three or more are a burst (an
+    # impact ringing near Nyquist: every other sample of it far out), and every other sample counts
+    big = np.zeros(x.size + 2, bool)
+    big[cand + 1] = True
+    single = cand[~big[cand] & ~big[cand + 2]]
+    if single.size == 0:
+        return np.zeros(0, np.int64)
+    b = a.copy()
+    b[single] = 0.0
+    k = np.arange(1, SPIKE_CONTEXT + 1)
+    near = np.clip(single[:, None] + np.concatenate((-k, k))[None, :], 0, x.size - 1)
+    around = b[near].max(axis=1)
+    others = (b[near] != a[near]).sum(axis=1)
+    found = single[(a[single] > isolation * around) & (others <= 1)].astype(np.int64)
+    grid = _grid(found)
+    if grid is None:
+        return found
+    # glitches at a fixed interval (a converter's buffer): every position of the grid whose residual
+    # stands out at all (GRID_SIGMA) is one, also where the vibration around it hides it from the test
+    n0, P = grid
+    pos = np.arange(n0 % P, x.size, P)
+    return np.union1d(found, pos[a[pos] > GRID_SIGMA * s]).astype(np.int64)
+
+
+def _grid(found: np.ndarray):
+    """(offset, period) when the spikes found sit on one grid of a fixed period (at least GRID_MIN of
+    them and GRID_SHARE of the intervals between them whole multiples of the period); else None."""
+    if found.size < GRID_MIN:
+        return None
+    d = np.diff(found)
+    vals, counts = np.unique(d, return_counts=True)
+    mode = int(vals[np.argmax(counts)])
+    # the most common interval may skip spikes the test missed: the period is the divisor of it that
+    # the most intervals are whole multiples of (of equals, the longest: half the period fits as well)
+    best, share = None, GRID_SHARE
+    for m in range(1, 9):
+        P = mode // m
+        if mode % m or P <= SPIKE_CONTEXT:
+            continue
+        on = float(np.mean(d % P == 0))
+        if on > share + 1e-9:
+            best, share = P, on
+    if best is None:
+        return None
+    n0 = int(np.bincount(found % best).argmax())
+    return (n0, best) if np.sum(found % best == n0) >= GRID_MIN else None
+
+
+def _repair(x: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    y = x.copy()
+    left = np.clip(idx - 1, 0, x.size - 1)
+    right = np.clip(idx + 1, 0, x.size - 1)
+    y[idx] = 0.5 * (x[left] + x[right])
+    return y
+
+
+def flat_runs(x, fs: float) -> list[tuple[int, int]]:
+    """(start, stop) of the runs of equal samples at least FLAT_RUN long and FLAT_SECONDS: a dropout (a
+    converter or a link that held or zeroed its output). Clipping (runs at the record's extremes) is
+    left to ``clipped_share``."""
+    x = np.asarray(x, dtype=np.float64)
+    if x.size < 2:
+        return []
+    same = np.concatenate(([False], x[1:] == x[:-1]))
+    d = np.diff(np.concatenate(([0], same.view(np.int8), [0])))
+    starts, ends = np.flatnonzero(d == 1) - 1, np.flatnonzero(d == -1)
+    need = max(FLAT_RUN, int(np.ceil(FLAT_SECONDS * fs)))
+    hi, lo = x.max(), x.min()
+    return [(int(s), int(e)) for s, e in zip(starts, ends)
+            if e - s >= need and x[s] != hi and x[s] != lo]
+
+
+def clipped_share(x) -> float:
+    """Share of the samples in runs of 3 or more at the record's maximum or minimum (far from its
+    median): the sensor or the converter saturated."""
+    from ..identify._decay import clipped_mask
+    x = np.asarray(x, dtype=np.float64)
+    return float(clipped_mask(x).mean()) if x.size else 0.0
+
+
+def despike(rec, *, fs: float | None = None, sigma: float = SPIKE_SIGMA,
+            isolation: float = SPIKE_ISOLATION) -> Record:
+    """The record with every isolated spike (``isolated_spikes``) replaced by the mean of its two
+    neighbours; a QualityWarning names each channel repaired and how many samples. ``sigma`` and
+    ``isolation`` are the two thresholds (defaults ``SPIKE_SIGMA``, ``SPIKE_ISOLATION``)."""
+    rec = as_record(rec, fs=fs)
+    for name, v, least in (("sigma", sigma, 3.0), ("isolation", isolation, 1.5)):
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) \
+                or not np.isfinite(v) or v < least:
+            raise ParameterError(f"{name}={v!r} must be a number >= {least:g}: lower, ordinary samples of a "
+                                 "vibration record would be taken for spikes")
+    if not np.isfinite(rec.data).all():
+        raise ParameterError("despike: the record has NaN/inf samples; the rule is finite data")
+    data = np.array(rec.data, dtype=np.float64)
+    found = {}
+    for i, ch in enumerate(rec.channels):
+        idx = isolated_spikes(data[i], sigma=sigma, isolation=isolation)
+        if idx.size:
+            data[i] = _repair(data[i], idx)
+            found[ch.name] = int(idx.size)
+    if not found:
+        return rec
+    warn_quality("despike: " + "; ".join(f"channel {k!r}: {v} isolated spike{'s' * (v > 1)} replaced"
+                                         for k, v in found.items()))
+    return rec.replace(data=data, note=f"despike(sigma={sigma:g}, isolation={isolation:g}): {found}")
