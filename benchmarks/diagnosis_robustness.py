@@ -1,5 +1,6 @@
 """Machine diagnosis on the development records when they come in another shape: resampled, low-passed,
-with an interference tone, with mains pickup (a 50 or 60 Hz comb), with added noise, cut shorter, with a wrong declared speed (1, 5 and 10 %, and
+with an interference tone, with mains pickup (a 50 or 60 Hz comb), damaged by the recording chain
+(single-sample spikes, regular or random; dropouts; clipping; 8-bit quantisation), with added noise, cut shorter, with a wrong declared speed (1, 5 and 10 %, and
 15, 20 and 30 %, beyond the 1X search, where the honest answer is "none": the record contradicts the speed), one
 channel alone (whole, and in 1 s pieces). Held-out recordings come from other rigs and converters, often with one sensor; a method
 that generalises keeps its answers (or says "none") and does not start making wrong calls.
@@ -54,6 +55,47 @@ def _mains(line_hz, amp):
     return f
 
 
+def _spikes(amp, every=None, per_second=None):
+    """Single-sample spikes of amp x each channel's RMS: one every ``every`` samples (a converter's buffer
+    boundary), or ``per_second`` at random places with alternating sign (switching transients)."""
+    def f(rec, rpm):
+        y = rec.data.astype(float).copy()
+        n = y.shape[1]
+        if every:
+            idx, sign = np.arange(every // 2, n, every), 1.0
+        else:
+            idx = np.sort(np.random.default_rng(3).choice(n - 1, size=int(per_second * n / rec.fs), replace=False))
+            sign = np.where(np.arange(idx.size) % 2, 1.0, -1.0)
+        y[:, idx] += amp * y.std(axis=1, keepdims=True) * sign
+        return _rebuilt(rec, y), rpm
+    return f
+
+
+def _dropouts(ms, per_second):
+    """Runs of zeros ``ms`` long, ``per_second`` at random places (a link or buffer that drops out)."""
+    def f(rec, rpm):
+        y = rec.data.astype(float).copy()
+        n, m = y.shape[1], int(ms * 1e-3 * rec.fs)
+        for s in np.random.default_rng(5).choice(n - m, size=int(per_second * n / rec.fs), replace=False):
+            y[:, s:s + m] = 0.0
+        return _rebuilt(rec, y), rpm
+    return f
+
+
+def _clipped(level):
+    def f(rec, rpm):
+        lim = level * rec.data.std(axis=1, keepdims=True)
+        return _rebuilt(rec, np.clip(rec.data, -lim, lim)), rpm
+    return f
+
+
+def _quantised(bits):
+    def f(rec, rpm):
+        step = 2 * np.abs(rec.data).max(axis=1, keepdims=True) / 2 ** bits
+        return _rebuilt(rec, np.round(rec.data / step) * step), rpm
+    return f
+
+
 def _piece(k, m):
     def f(rec, rpm):
         n = rec.n_samples // m
@@ -87,6 +129,15 @@ VARIANTS = {
     # mains pickup: taken for a shaft, such a comb contradicted the declared speed (nothing checked)
     "mains 50 Hz comb at 0.3 x the RMS": _mains(50.0, 0.3),
     "mains 60 Hz comb at 0.3 x the RMS": _mains(60.0, 0.3),
+    # damage of the recording chain: isolated spikes are repaired (signal.quality), and the comb a
+    # regular spike train's repairs leave at fs / interval is claimed; the rest is only flagged
+    "spike of 30 x the RMS every 1024 samples": _spikes(30.0, every=1024),
+    "spike of 10 x the RMS every 1024 samples": _spikes(10.0, every=1024),
+    "random spikes of 30 x the RMS, 5 a second": _spikes(30.0, per_second=5),
+    "random spikes of 30 x the RMS, 50 a second": _spikes(30.0, per_second=50),
+    "dropouts of 10 ms, 1 a second": _dropouts(10.0, 1),
+    "clipped at 3 x the RMS": _clipped(3.0),
+    "quantised to 8 bits": _quantised(8),
     "noise at the record's RMS": lambda rec, rpm: (_rebuilt(rec, rec.data + np.random.default_rng(0).normal(
         size=rec.data.shape) * rec.data.std(axis=1, keepdims=True)), rpm),
     "rpm declared 1 % high": lambda rec, rpm: (rec, 1.01 * rpm),

@@ -34,6 +34,7 @@ SPIKE_PASSES = 3        # passes, each on the record with the spikes found befor
 GRID_MIN = 5            # spikes on one grid of a fixed interval: at least this many ...
 GRID_SHARE = 0.8        # ... with this share of the intervals between them whole multiples of it
 GRID_SIGMA = 3.0        # on such a grid, a residual this far out (robust sigmas) is a spike too
+CLIP_MIN = 5            # saturation: this many samples exactly at the record's maximum or minimum
 FLAT_RUN = 8            # a dropout: this many equal samples or more in a row (and at least 0.5 ms) ...
 FLAT_SECONDS = 5e-4
 
@@ -41,7 +42,9 @@ FLAT_SECONDS = 5e-4
 def _residual(x: np.ndarray) -> tuple[np.ndarray, float]:
     from scipy.ndimage import median_filter
     r = x - median_filter(x, size=7, mode="reflect")
-    return r, 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    s = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    # over half the residuals 0 (a flat or coarsely quantised record): their mean size instead
+    return r, s if s > 0.0 else (float(np.mean(np.abs(r))) or 1.0)
 
 
 def isolated_spikes(x, *, sigma: float = SPIKE_SIGMA, isolation: float = SPIKE_ISOLATION) -> np.ndarray:
@@ -59,14 +62,20 @@ def isolated_spikes(x, *, sigma: float = SPIKE_SIGMA, isolation: float = SPIKE_I
         if not new.size:
             break
         found = np.union1d(found, new)
-    return found
+    grid = _grid(found)
+    if grid is None:
+        return found
+    # glitches at a fixed interval (a converter's buffer): every position of the grid whose residual
+    # stands out at all (GRID_SIGMA) is one, also where the vibration around it hides it from the test
+    n0, P = grid
+    r, s = _residual(x)
+    pos = np.arange(n0 % P, x.size, P)
+    return np.union1d(found, pos[np.abs(r[pos]) > GRID_SIGMA * s]).astype(np.int64)
 
 
 def _spikes_once(x: np.ndarray, sigma: float, isolation: float) -> np.ndarray:
     r, s = _residual(x)
     a = np.abs(r)
-    if s == 0.0:   # over half the residuals are 0 (a flat or coarsely quantised record)
-        s = float(np.mean(a)) or 1.0
     # far out against the residual's spread, and against the record itself: on a smooth, oversampled
     # record (a slow ring-down) the residual's spread is tiny and a wiggle of 0.3 % of the RMS is no spike
     level = SPIKE_LEVEL * 1.4826 * float(np.median(np.abs(x - np.median(x))))
@@ -87,15 +96,7 @@ def _spikes_once(x: np.ndarray, sigma: float, isolation: float) -> np.ndarray:
     near = np.clip(single[:, None] + np.concatenate((-k, k))[None, :], 0, x.size - 1)
     around = b[near].max(axis=1)
     others = (b[near] != a[near]).sum(axis=1)
-    found = single[(a[single] > isolation * around) & (others <= 1)].astype(np.int64)
-    grid = _grid(found)
-    if grid is None:
-        return found
-    # glitches at a fixed interval (a converter's buffer): every position of the grid whose residual
-    # stands out at all (GRID_SIGMA) is one, also where the vibration around it hides it from the test
-    n0, P = grid
-    pos = np.arange(n0 % P, x.size, P)
-    return np.union1d(found, pos[a[pos] > GRID_SIGMA * s]).astype(np.int64)
+    return single[(a[single] > isolation * around) & (others <= 1)].astype(np.int64)
 
 
 def _grid(found: np.ndarray):
@@ -147,11 +148,21 @@ def flat_runs(x, fs: float) -> list[tuple[int, int]]:
 
 
 def clipped_share(x) -> float:
-    """Share of the samples in runs of 3 or more at the record's maximum or minimum (far from its
-    median): the sensor or the converter saturated."""
-    from ..identify._decay import clipped_mask
+    """Share of the samples that sit exactly at the record's maximum or minimum, counted for an
+    extreme that at least CLIP_MIN samples reach and that lies far from the median (at least half the
+    largest excursion): the sensor or the converter saturated. (A recorded value at its extreme
+    occurs once; at 12 kHz a clipped excursion often lasts one or two samples, so runs are not asked.)"""
     x = np.asarray(x, dtype=np.float64)
-    return float(clipped_mask(x).mean()) if x.size else 0.0
+    if x.size == 0:
+        return 0.0
+    med = float(np.median(x))
+    reach = float(np.max(np.abs(x - med)))
+    n = 0
+    for ext in (float(x.max()), float(x.min())):
+        if reach > 0 and abs(ext - med) >= 0.5 * reach:
+            k = int(np.count_nonzero(x == ext))
+            n += k if k >= CLIP_MIN else 0
+    return n / x.size
 
 
 def despike(rec, *, fs: float | None = None, sigma: float = SPIKE_SIGMA,
