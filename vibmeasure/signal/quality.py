@@ -10,10 +10,15 @@ Measured on the 53 development fault records (``benchmarks/diagnosis_robustness.
 every 1024 samples gave 7 wrong calls, five random ones a second left 5 of 39 right answers.
 
 ``isolated_spikes`` finds them: a sample whose departure from the running median of 7 (the residual)
-is both ``SPIKE_SIGMA`` times the residual's robust spread (MAD) and ``SPIKE_ISOLATION`` times the
-largest residual of the ``SPIKE_CONTEXT`` samples on each side. On every channel of the 57 development
-recordings (CWRU at 12 kHz, MFPT at 48.8 kHz, impacts of faulty bearings included) the largest such
-ratio is 2.96, and no sample is found. ``despike`` replaces each by the mean of its two neighbours.
+is ``SPIKE_SIGMA`` times the residual's robust spread (MAD), ``SPIKE_LEVEL`` times the record's own,
+and ``SPIKE_ISOLATION`` times the largest residual of the ``SPIKE_CONTEXT`` samples on each side
+(other single far-out samples there excepted, unless there are two or more: a burst). Spikes on one
+grid of a fixed interval (``_grid``) are completed along it. On every channel of the 57 development
+recordings (CWRU at 12 kHz, MFPT at 48.8 kHz, impacts of faulty bearings included) no sample is
+found, even at 8 sigma and 3 x; the first false find is at 6 sigma and 3 x. ``despike`` replaces
+each by the mean of its two neighbours.
+
+``flat_runs`` (dropouts) and ``clipped_share`` (saturation) only measure: what they hide is lost.
 """
 
 from __future__ import annotations
@@ -42,7 +47,7 @@ FLAT_SECONDS = 5e-4
 def _residual(x: np.ndarray) -> tuple[np.ndarray, float]:
     from scipy.ndimage import median_filter
     r = x - median_filter(x, size=7, mode="reflect")
-    s = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    s = 1.4826 * float(np.median(np.abs(r)))   # the residual's median is 0 by construction (to a sample)
     # over half the residuals 0 (a flat or coarsely quantised record): their mean size instead
     return r, s if s > 0.0 else (float(np.mean(np.abs(r))) or 1.0)
 
@@ -53,8 +58,9 @@ def isolated_spikes(x, *, sigma: float = SPIKE_SIGMA, isolation: float = SPIKE_I
     x = np.asarray(x, dtype=np.float64)
     if x.ndim != 1 or x.size < 2 * SPIKE_CONTEXT + 1:
         return np.zeros(0, np.int64)
-    # two spikes within SPIKE_CONTEXT of each other hide each other: once the first pass has repaired
-    # one, the next finds the other (50 random spikes a second at 12 kHz: 90 % found in one pass)
+    # a spike among others near it can stand out only once they are repaired: 500 random spikes of
+    # 30 x the RMS in 10 s on the 135 channels of the CWRU fan-end records, 98.3 % found in one pass,
+    # 98.5 % in three
     found = np.zeros(0, np.int64)
     for _ in range(SPIKE_PASSES):
         new = _spikes_once(_repair(x, found) if found.size else x, sigma, isolation)
@@ -78,8 +84,9 @@ def _spikes_once(x: np.ndarray, sigma: float, isolation: float) -> np.ndarray:
     a = np.abs(r)
     # far out against the residual's spread, and against the record itself: on a smooth, oversampled
     # record (a slow ring-down) the residual's spread is tiny and a wiggle of 0.3 % of the RMS is no spike
-    level = SPIKE_LEVEL * 1.4826 * float(np.median(np.abs(x - np.median(x))))
-    cand = np.flatnonzero((a > sigma * s) & (a > level))
+    cand = np.flatnonzero(a > sigma * s)
+    if cand.size:
+        cand = cand[a[cand] > SPIKE_LEVEL * 1.4826 * float(np.median(np.abs(x - np.median(x))))]
     if cand.size == 0:
         return np.zeros(0, np.int64)
     # a candidate whose neighbour is one too is no single sample; two single ones within SPIKE_CONTEXT
@@ -109,13 +116,13 @@ def _grid(found: np.ndarray):
     mode = int(vals[np.argmax(counts)])
     # the most common interval may skip spikes the test missed: the period is the divisor of it that
     # the most intervals are whole multiples of (of equals, the longest: half the period fits as well)
-    best, share = None, GRID_SHARE
+    best, share = None, 0.0
     for m in range(1, 9):
         P = mode // m
         if mode % m or P <= SPIKE_CONTEXT:
             continue
         on = float(np.mean(d % P == 0))
-        if on > share + 1e-9:
+        if on >= GRID_SHARE and on > share + 1e-9:
             best, share = P, on
     if best is None:
         return None
@@ -124,9 +131,10 @@ def _grid(found: np.ndarray):
 
 
 def _repair(x: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """x with the samples at idx replaced by the mean of their two neighbours (at an end, by its one)."""
     y = x.copy()
-    left = np.clip(idx - 1, 0, x.size - 1)
-    right = np.clip(idx + 1, 0, x.size - 1)
+    left = np.where(idx > 0, idx - 1, idx + 1)
+    right = np.where(idx < x.size - 1, idx + 1, idx - 1)
     y[idx] = 0.5 * (x[left] + x[right])
     return y
 
@@ -155,13 +163,13 @@ def clipped_share(x) -> float:
     x = np.asarray(x, dtype=np.float64)
     if x.size == 0:
         return 0.0
+    hi, lo = float(x.max()), float(x.min())
+    at = {e: int(np.count_nonzero(x == e)) for e in (hi, lo)}
+    if max(at.values()) < CLIP_MIN:
+        return 0.0
     med = float(np.median(x))
-    reach = float(np.max(np.abs(x - med)))
-    n = 0
-    for ext in (float(x.max()), float(x.min())):
-        if reach > 0 and abs(ext - med) >= 0.5 * reach:
-            k = int(np.count_nonzero(x == ext))
-            n += k if k >= CLIP_MIN else 0
+    reach = max(hi - med, med - lo)
+    n = sum(k for e, k in at.items() if k >= CLIP_MIN and reach > 0 and abs(e - med) >= 0.5 * reach)
     return n / x.size
 
 
