@@ -322,13 +322,8 @@ def _claim_artefact(ses: _SES, hz: float):
     """Every harmonic of a comb the recording chain made at an exactly known frequency (spikes every P
     samples, repaired: what the repair cannot restore repeats every P samples) is claimed, standing or
     not; a bearing line that falls within a bin of one is lost with it."""
-    df = ses.freq[1]
-    for k in range(1, int((ses.n_valid - 2) * df / hz) + 1):
-        i = int(round(k * hz / df))
-        if 2 <= i < ses.n_valid - 2 and ses.r[i - 1: i + 2].max() > 2.0:
-            _mask(ses, i * df)
-        elif 2 <= i < ses.n_valid - 2:
-            ses.r[i - 1: i + 2] = 0.0
+    for k in range(1, int((ses.n_valid - 2) * ses.freq[1] / hz) + 1):
+        _mask(ses, k * hz)
 
 
 def _claim_cage(ses: _SES, ftf: float, n_balls: int) -> dict | None:

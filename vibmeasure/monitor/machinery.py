@@ -830,6 +830,12 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     ``speed_varies``) gives the speed profile instead (``speed["source"]`` "1X line"). The ISO
     severity is taken from the record as measured.
 
+    Every channel is checked for the recording chain's damage first (``signal.quality``): isolated
+    spikes are replaced by the mean of their neighbours (flag ``spikes_removed``; spikes at a fixed
+    interval of P samples also have the comb at fs / P claimed in the envelope spectra), dropouts and
+    saturation are flagged (``dropouts``, ``saturated``); ``extras["data_quality"]`` holds the findings
+    per channel, and a QualityWarning names them.
+
     The 1X is looked for within 12 % of ``rpm``. When the record contradicts the declared speed (a
     shaft comb stands elsewhere, 10 dB above the 1X candidate and with more harmonics, in any channel),
     the flag is ``speed_contradicted``, ``speed["contradicting_rpm"]`` says where the comb stands, and
