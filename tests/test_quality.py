@@ -1,6 +1,7 @@
 """Damage of the recording chain in the samples: isolated spikes (found, repaired), dropouts, clipping;
 and what diagnose does with them."""
 
+import json
 import warnings
 
 import numpy as np
@@ -175,3 +176,21 @@ def test_diagnose_reports_dropouts_and_saturation():
     assert d.top == "bearing_outer_race"
     clean = vm.diagnose(rec, rpm=1797, bearing="6205-2RS")
     assert "data_quality" not in clean.extras and not {"spikes_removed", "dropouts", "saturated"} & set(clean.flags)
+
+
+def test_the_command_line_prints_the_damage_as_a_warning(tmp_path):
+    """vibmeasure diagnose: the damage found goes to stderr as "vibmeasure: warning: ..." and into the
+    JSON document's "warnings" (as the other commands' quality warnings do), not as Python's raw
+    warning with a source line."""
+    from tests.test_cli import run
+    rec = _machine()
+    x = rec.data[0].astype(float)
+    x[::1024] += 30 * x.std()
+    f = tmp_path / "glitchy.h5"
+    vm.write(f, vm.Record.from_array(x, fs=rec.fs, names=["acc"], unit="g"))
+    code, out, err = run(["diagnose", str(f), "--rpm", "1797", "--bearing", "6205-2RS"])
+    assert code == 0 and out.startswith(f"{f}: NONE")
+    assert err.startswith("vibmeasure: warning: diagnose: channel 'acc': 71 isolated spikes") and "cli.py" not in err
+    code, out, err = run(["diagnose", str(f), "--rpm", "1797", "--bearing", "6205-2RS", "--json"])
+    doc = json.loads(out)
+    assert doc["flags"] == ["spikes_removed"] and "one every 1024 samples" in doc["warnings"][0]

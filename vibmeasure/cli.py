@@ -421,17 +421,24 @@ def _main_diagnose(args, out, err) -> int:
             except ValueError:
                 raise VibMeasureError(f"--bearing-geometry {args.bearing_geometry!r} must be N,d,D,angle") from None
             bearing = Bearing(int(n), d, D, ang)
-        diag = diagnose(rec, rpm=args.rpm, bearing=bearing, gear=args.gear, machine_group=args.group,
-                        foundation=args.foundation, channel=primary, line_frequency=args.line_frequency,
-                        prewhitening=tuple(args.prewhitening), tach=args.tach, pulses_per_rev=args.pulses_per_rev)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", QualityWarning)
+            diag = diagnose(rec, rpm=args.rpm, bearing=bearing, gear=args.gear, machine_group=args.group,
+                            foundation=args.foundation, channel=primary, line_frequency=args.line_frequency,
+                            prewhitening=tuple(args.prewhitening), tach=args.tach,
+                            pulses_per_rev=args.pulses_per_rev)
+        msgs = [str(w.message) for w in caught if issubclass(w.category, QualityWarning)]
         if args.plot:
             axes = _plot_module().plot_diagnosis(rec, diag)
             _save_figure(axes[0].figure, args.plot)
     except (VibMeasureError, OSError) as exc:
         print(f"vibmeasure: error: {exc}", file=err)
         return 2
+    for m in msgs:
+        print(f"vibmeasure: warning: {m}", file=err)
     if args.json:
-        json.dump({"command": "diagnose", "file": str(args.file), **diag.to_dict()}, out, indent=2, allow_nan=False)
+        json.dump({"command": "diagnose", "file": str(args.file), **diag.to_dict(), "warnings": msgs}, out,
+                  indent=2, allow_nan=False)
         out.write("\n")
     else:
         sev = diag.severity
