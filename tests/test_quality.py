@@ -194,3 +194,21 @@ def test_the_command_line_prints_the_damage_as_a_warning(tmp_path):
     code, out, err = run(["diagnose", str(f), "--rpm", "1797", "--bearing", "6205-2RS", "--json"])
     doc = json.loads(out)
     assert doc["flags"] == ["spikes_removed"] and "one every 1024 samples" in doc["warnings"][0]
+
+
+def test_the_measures_refuse_bad_input():
+    x = np.zeros(100)
+    for f in (q.isolated_spikes, q.clipped_share, lambda a: q.flat_runs(a, 100.0)):
+        with pytest.raises(vm.ParameterError, match=r"x must be one channel's samples \(1-D\), got shape \(2, 50\)"):
+            f(x.reshape(2, 50))
+        with pytest.raises(vm.ParameterError, match="x has NaN/inf samples .first at index 3."):
+            f(np.where(np.arange(100) == 3, np.nan, 0.0))
+        with pytest.raises(vm.ParameterError, match="x must be an array of numbers"):
+            f("abc")
+    with pytest.raises(vm.ParameterError, match="isolation=1.0 must be a number >= 1.5"):
+        q.isolated_spikes(x, isolation=1.0)
+    for bad in (0, -1.0, np.inf):
+        with pytest.raises(vm.ParameterError, match="fs="):
+            q.flat_runs(x, bad)
+    # too short to judge a sample against its 16 neighbours on each side, and empty: nothing found
+    assert q.isolated_spikes(np.arange(32.0)).size == 0 and q.clipped_share(np.zeros(0)) == 0.0

@@ -115,13 +115,13 @@ def _line(freq, values, f, tol, floor_halfwidth):
 
 # --- prepare ---------------------------------------------------------------------------------------
 
-def _accel(rec, i, flags, quality=None):
+def _accel(rec, i, flags, quality):
     """Channel i as float64, in m/s^2 when its unit is a known acceleration unit, with its isolated
     spikes repaired (``signal.quality``); ``quality`` (channel -> findings) collects what the samples
     show of the recording chain's damage: spikes, dropouts, saturation."""
     x = clean_signal(rec, i, min_samples=256)
     ch = rec.channels[i]
-    x = _damage(x, rec.fs, ch.name, flags, {} if quality is None else quality)
+    x = _damage(x, rec.fs, ch.name, flags, quality)
     if ch.unit and ch.quantity == "acceleration":
         x = _units.convert(x, ch.unit, "m/s^2")
     elif "unit_unknown" not in flags:

@@ -44,6 +44,28 @@ FLAT_RUN = 8            # a dropout: this many equal samples or more in a row (a
 FLAT_SECONDS = 5e-4
 
 
+def _samples(x, name: str = "x") -> np.ndarray:
+    """One channel's samples as float64: a 1-D, finite array, else a ParameterError naming ``name``."""
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be an array of numbers (one channel's samples)") from None
+    if a.ndim != 1:
+        raise ParameterError(f"{name} must be one channel's samples (1-D), got shape {a.shape}")
+    if not np.isfinite(a).all():
+        i = int(np.argmax(~np.isfinite(a)))
+        raise ParameterError(f"{name} has NaN/inf samples (first at index {i}); the rule is finite data")
+    return a
+
+
+def _thresholds(sigma, isolation) -> None:
+    for name, v, least in (("sigma", sigma, 3.0), ("isolation", isolation, 1.5)):
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) \
+                or not np.isfinite(v) or v < least:
+            raise ParameterError(f"{name}={v!r} must be a number >= {least:g}: lower, ordinary samples of a "
+                                 "vibration record would be taken for spikes")
+
+
 def _residual(x: np.ndarray) -> tuple[np.ndarray, float]:
     from scipy.ndimage import median_filter
     r = x - median_filter(x, size=7, mode="reflect")
@@ -54,9 +76,11 @@ def _residual(x: np.ndarray) -> tuple[np.ndarray, float]:
 
 def isolated_spikes(x, *, sigma: float = SPIKE_SIGMA, isolation: float = SPIKE_ISOLATION) -> np.ndarray:
     """Indices of the single samples that stand far from both neighbours and from every sample near
-    them (see the module's docstring); an empty array when there are none."""
-    x = np.asarray(x, dtype=np.float64)
-    if x.ndim != 1 or x.size < 2 * SPIKE_CONTEXT + 1:
+    them (see the module's docstring); an empty array when there are none, or when the record is
+    shorter than 2 x SPIKE_CONTEXT + 1 samples (too little around a sample to judge it)."""
+    x = _samples(x)
+    _thresholds(sigma, isolation)
+    if x.size < 2 * SPIKE_CONTEXT + 1:
         return np.zeros(0, np.int64)
     # a spike among others near it can stand out only once they are repaired: 500 random spikes of
     # 30 x the RMS in 10 s on the 135 channels of the CWRU fan-end records, 98.3 % found in one pass,
@@ -143,7 +167,9 @@ def flat_runs(x, fs: float) -> list[tuple[int, int]]:
     """(start, stop) of the runs of equal samples at least FLAT_RUN long and FLAT_SECONDS: a dropout (a
     converter or a link that held or zeroed its output). Clipping (runs at the record's extremes) is
     left to ``clipped_share``."""
-    x = np.asarray(x, dtype=np.float64)
+    from ..core._validate import positive
+    x = _samples(x)
+    fs = positive(fs, "fs")
     if x.size < 2:
         return []
     same = np.concatenate(([False], x[1:] == x[:-1]))
@@ -160,7 +186,7 @@ def clipped_share(x) -> float:
     extreme that at least CLIP_MIN samples reach and that lies far from the median (at least half the
     largest excursion): the sensor or the converter saturated. (A recorded value at its extreme
     occurs once; at 12 kHz a clipped excursion often lasts one or two samples, so runs are not asked.)"""
-    x = np.asarray(x, dtype=np.float64)
+    x = _samples(x)
     if x.size == 0:
         return 0.0
     hi, lo = float(x.max()), float(x.min())
@@ -178,14 +204,10 @@ def despike(rec, *, fs: float | None = None, sigma: float = SPIKE_SIGMA,
     """The record with every isolated spike (``isolated_spikes``) replaced by the mean of its two
     neighbours; a QualityWarning names each channel repaired and how many samples. ``sigma`` and
     ``isolation`` are the two thresholds (defaults ``SPIKE_SIGMA``, ``SPIKE_ISOLATION``)."""
+    from .preprocess import _finite
     rec = as_record(rec, fs=fs)
-    for name, v, least in (("sigma", sigma, 3.0), ("isolation", isolation, 1.5)):
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) \
-                or not np.isfinite(v) or v < least:
-            raise ParameterError(f"{name}={v!r} must be a number >= {least:g}: lower, ordinary samples of a "
-                                 "vibration record would be taken for spikes")
-    if not np.isfinite(rec.data).all():
-        raise ParameterError("despike: the record has NaN/inf samples; the rule is finite data")
+    _thresholds(sigma, isolation)
+    _finite(rec, "despike")
     data = np.array(rec.data, dtype=np.float64)
     found = {}
     for i, ch in enumerate(rec.channels):
