@@ -183,8 +183,9 @@ def flat_runs(x, fs: float) -> list[tuple[int, int]]:
 
 def clipped_share(x) -> float:
     """Share of the samples that sit exactly at the record's maximum or minimum, counted for an
-    extreme that at least CLIP_MIN samples reach and that lies far from the median (at least half the
-    largest excursion): the sensor or the converter saturated. (A recorded value at its extreme
+    extreme that at least CLIP_MIN samples reach, more than twice as many as the next value inside it,
+    and that lies far from the median (at least half the largest excursion): the sensor or the
+    converter saturated. (A recorded value at its extreme
     occurs once; at 12 kHz a clipped excursion often lasts one or two samples, so runs are not asked.)"""
     x = _samples(x)
     if x.size == 0:
@@ -195,7 +196,20 @@ def clipped_share(x) -> float:
         return 0.0
     med = float(np.median(x))
     reach = max(hi - med, med - lo)
-    n = sum(k for e, k in at.items() if k >= CLIP_MIN and reach > 0 and abs(e - med) >= 0.5 * reach)
+
+    def piled(e):
+        """More samples at the extreme than twice at the next value inside it (to within rounding): a
+        rail. A noise-free periodic signal repeats its extreme once a period and the values beside it as
+        often or more (a sine with a whole number of samples per period: twice as often; before this
+        test every such test sine read as saturated), and the next code of a quantised signal that
+        does not reach its rail is commoner than its top code."""
+        inside = x[x < e] if e == hi else x[x > e]
+        if inside.size == 0:
+            return False
+        nxt = inside.max() if e == hi else inside.min()
+        return at[e] > 2 * int(np.count_nonzero(np.abs(inside - nxt) <= 1e-9 * reach))
+
+    n = sum(k for e, k in at.items() if k >= CLIP_MIN and reach > 0 and abs(e - med) >= 0.5 * reach and piled(e))
     return n / x.size
 
 
