@@ -176,6 +176,10 @@ def test_diagnose_reports_dropouts_and_saturation():
     assert d.top == "bearing_outer_race"
     clean = vm.diagnose(rec, rpm=1797, bearing="6205-2RS")
     assert "data_quality" not in clean.extras and not {"spikes_removed", "dropouts", "saturated"} & set(clean.flags)
+    # the clipped peaks are lost: the severity reads lower than the clean record's and says it is a bound
+    assert d.severity["lower_bound"] and "lower bound" in d.severity["note"]
+    assert d.severity["velocity_rms_mm_s"] < clean.severity["velocity_rms_mm_s"]
+    assert "lower_bound" not in clean.severity
 
 
 def test_the_command_line_prints_the_damage_as_a_warning(tmp_path):

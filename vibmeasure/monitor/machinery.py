@@ -495,7 +495,8 @@ def _mains_lines(f, A, f1, mains) -> tuple[list, list]:
                 for k in range(1, int(top / m_act) + 1):
                     fk = k * m_act
                     order = round(fk / half) * half
-                    for fc in standing(fk, 0.75 * df + MAINS_DRIFT * k * m):
+                    near = sorted(standing(fk, 0.75 * df + MAINS_DRIFT * k * m), key=lambda v: abs(v - fk))
+                    for fc in near[:1]:   # one line per harmonic: the nearest
                         low |= k <= 2
                         if _electrical(fc, fk, f1, df):
                             own.append((k, fc))
@@ -1003,6 +1004,13 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
                                        electrical, supply_amp)
     if severity["velocity_rms_mm_s"] is None:
         v_rms = np.nan
+    saturated = job.quality.get(job.primary, {}).get("saturated_share")
+    if saturated and severity["velocity_rms_mm_s"] is not None:
+        # the peaks beyond the converter's range are lost: what is measured is less than what shook
+        severity["lower_bound"] = True
+        severity["note"] = "; ".join(filter(None, [severity["note"], (
+            f"the channel saturated ({100 * saturated:.2g} % of its samples at its extremes): the level is a "
+            f"lower bound")]))
     _, _, V = _spectrum(shaft_job)
     rows, order = sf.shaft_order_rows(f, V, f1, v_rms, level, job.flags, _line, _row, LINE_DB)
     rows.append(sf.resonance_row(f, _spectrum(shaft_job, "blackmanharris")[1], f1, order, level, rows, _row, LINE_DB))
