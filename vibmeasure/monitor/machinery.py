@@ -446,19 +446,21 @@ def _mains_lines(f, A, f1, mains) -> tuple[list, list]:
 
     For each line frequency m in ``mains``, a line standing LINE_DB above the floor beside it (3-200
     lines off) within MAINS_TOL (plus half a line) of one of the harmonics k0 x m, k0 = 1-3, fixes the
-    supply's actual frequency m' (the grid drifts, its harmonics with it); the comb is the lines standing
-    within 0.75 line plus MAINS_DRIFT of the harmonics k x m' up to MAINS_TOP_HZ. A line closer to k x m'
-    than to every shaft order and half order, and further from it than the order's uncertainty
-    (``_electrical``), is the supply's; one closer to a shaft order is both the supply's and the shaft's: the supply's harmonic and that order are fitted
-    together, when they are half a line apart or more (closer, the line is left to the shaft). A comb
-    holds a line at m' or 2 m', and two lines of the supply's own or one at m' or 2 m'; of the combs
-    the one with the most. (Without a line at m' or 2 m', lines of the CWRU rig's machine at 150.4,
-    551.5 and 701.9 Hz made a 50.13 Hz comb on a 60 Hz supply.)
+    supply's actual frequency m' (the grid drifts, its harmonics with it); the comb is the line nearest
+    each harmonic k x m' up to MAINS_TOP_HZ, within 0.75 line plus MAINS_DRIFT. A line closer to k x m'
+    than to every shaft order and half order, and further from the order than its uncertainty
+    (``_electrical``), is the supply's own. One closer to a shaft order is the supply's and the shaft's
+    both: the supply's harmonic and that order are fitted together when they are half a line apart or
+    more (closer, the line is left to the shaft). A comb holds a line at m' or 2 m', and two lines of
+    the supply's own or one at m' or 2 m'; of the combs, the one with the most lines of its own.
+    (Without the line at m' or 2 m', lines of the CWRU rig at 150.4, 551.5 and 701.9 Hz made a 50.13 Hz
+    comb on its 60 Hz supply.)
 
-    A supply frequency that is a shaft order (or half order) j x f1 to within a quarter of a line times j
-    (f1, measured from the 1X line, is known to about a quarter of a line), plus a quarter of a line over
-    k0 (m' from the k0-th harmonic), makes no comb: its lines are the shaft's as much. (A healthy synthetic machine with strong shaft-rate impacts at 1797 rpm, 1X measured 0.15 line
-    low, had its 4X-32X taken for a 59.9 Hz supply's comb, and 2X alone was left for misalignment.)
+    A supply frequency that is a shaft order (or half order) j x f1 to within a quarter of a line times
+    j (f1, measured from the 1X line, is known to about a quarter of a line), plus a quarter of a line
+    over k0 (m' comes from the k0-th harmonic), makes no comb: its lines are the shaft's as much. (A
+    healthy synthetic machine with strong shaft-rate impacts at 1797 rpm, its 1X measured 0.15 line low,
+    had its 4X-32X taken for a 59.9 Hz supply's comb, and 2X alone was left for misalignment.)
 
     Mains pickup is no vibration of the shaft, and the motor's electromagnetic force at twice the line
     frequency is none either. Taken for the shaft's, a 50 or 60 Hz comb at 0.3 x the RMS added to the
@@ -489,8 +491,9 @@ def _mains_lines(f, A, f1, mains) -> tuple[list, list]:
             for fc0 in standing(k0 * m, MAINS_TOL * k0 * m + 0.5 * df):
                 m_act = fc0 / k0
                 q = max(1, round(m_act / half))   # the shaft's comb nearest to the supply's: q half orders
-                if not _electrical(fc0, fc0, f1, df) or abs(m_act - q * half) <= 0.25 * df * (max(1.0, 0.5 * q) + 1.0 / k0):
-                    continue   # the two combs cannot be told apart (f1 itself is known to half a line)
+                coincide = abs(m_act - q * half) <= 0.25 * df * (max(1.0, 0.5 * q) + 1.0 / k0)
+                if coincide or not _electrical(fc0, fc0, f1, df):
+                    continue   # the two combs cannot be told apart, or this line is a shaft order's
                 own, mixed, low = [], [], False
                 for k in range(1, int(top / m_act) + 1):
                     fk = k * m_act
@@ -518,11 +521,11 @@ def _electrical(fc, f_supply, f1, df) -> bool:
 
 
 def _supply_part(x, fs, lines_hz, beside_hz=()):
-    """The supply's lines in x and their amplitudes: sinusoids at ``lines_hz`` fitted by least squares together with those at
-    ``beside_hz`` (shaft orders beside them, which are not returned). Complex amplitudes; the Gram matrix
-    of the exponentials in closed form, the negative-frequency terms left out (they add 1 / (N x the
-    line's frequency in bins) of coupling). Fitted together, a shaft order beside a supply line keeps its
-    own amplitude: a window's leakage would lend it the supply's."""
+    """The supply's lines in x and their amplitudes: sinusoids at ``lines_hz`` fitted by least squares
+    together with those at ``beside_hz`` (shaft orders beside them, which are not returned). Complex
+    amplitudes; the Gram matrix of the exponentials in closed form, the negative-frequency terms left out
+    (they add 1 / (N x the line's frequency in bins) of coupling). Fitted together, a shaft order beside
+    a supply line keeps its own amplitude: a window's leakage would lend it the supply's."""
     n = x.size
     w = 2 * np.pi * np.concatenate([np.asarray(lines_hz, float), np.asarray(beside_hz, float)]) / fs
     d = w[None, :] - w[:, None]
@@ -1000,8 +1003,8 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     electrical, beside = _mains_lines(f, A, f1, job.mains) if steady else ([], [])
     supply, supply_amp = _supply_part(job.a, job.fs, electrical, beside) if electrical else (0.0, ())
     shaft_job = replace(job, a=job.a - supply) if electrical else job
-    severity, level, v_rms, level_all = _severity(measured, np.fft.rfftfreq(measured.a.size, 1 / measured.fs), measured.rpm,
-                                       electrical, supply_amp)
+    severity, level, v_rms, level_all = _severity(measured, np.fft.rfftfreq(measured.a.size, 1 / measured.fs),
+                                                  measured.rpm, electrical, supply_amp)
     if severity["velocity_rms_mm_s"] is None:
         v_rms = np.nan
     saturated = job.quality.get(job.primary, {}).get("saturated_share")
