@@ -399,6 +399,52 @@ def test_a_machine_declared_25_percent_slow_is_contradicted_by_its_own_shaft_com
     assert d.speed["contradicting_rpm"] == pytest.approx(rec.meta["rpm"], rel=5e-4)
 
 
+def test_bearing_lines_contradict_a_declared_speed_no_1x_confirms(shared_data):
+    # MFPT's 1X (12-20 dB, one harmonic) is found within +-12 % of the right speed but cannot contradict a
+    # wrong one: declared 15 % slow, BPFI - 2X and its multiples (68.5, 137 Hz) stood as BPFO x 1, 2 at
+    # -0.7 % slip, and outer race was called (p = 4.5e-8). The inner race's own comb with its +-1X
+    # sidebands stands where the true speed puts it (p = 1e-38): the declared speed is contradicted by
+    # the bearing's lines, nothing is called, and the speed they imply is the 1X measured at the right
+    # declared speed to within 1 % (the rolling elements' slip moves bearing lines by up to ~1-2 %)
+    import scipy.io as sio
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    f = shared_data("mfpt/InnerRaceFault_vload_2.mat")
+    rpm = 60 * float(sio.loadmat(f, squeeze_me=True)["bearing"]["rate"].item())
+    rec = vm.read(f, channels=["bearing.gs"], unit="g")
+    right = vm.diagnose(rec, rpm=rpm, bearing="MFPT")
+    assert right.top == "bearing_inner_race" and "speed_contradicted" not in right.flags
+    true = right.speed["estimated_rpm"]
+    d = vm.diagnose(rec, rpm=0.85 * rpm, bearing="MFPT")
+    assert d.top == "none" and "speed_contradicted" in d.flags and "bearing_not_checked" in d.flags
+    assert not d.bearing_checked and (d.faults.confidence == 0).all()
+    assert d.speed["contradicted_by"] == "bearing lines" and d.speed["estimated_rpm"] is None
+    comb = d.speed["bearing_comb"]
+    assert comb["family"] == "bearing_inner_race" and comb["p_value"] < 1e-3 * comb["declared_p_value"]
+    assert d.speed["contradicting_rpm"] == pytest.approx(true, rel=0.01)
+    assert "contradicted by the bearing's lines" in d.reason
+    json.dumps(d.to_dict(), allow_nan=False)   # the comb's figures go out with --json
+
+
+@pytest.mark.parametrize("fault", ["bearing_outer_race", "bearing_inner_race", "bearing_ball"])
+def test_a_synthetic_bearing_fault_at_a_wrong_speed_is_not_named(fault):
+    # the synthesiser's machines have a 1X without harmonics, which contradicts no wrong speed: declared
+    # 20 % slow or fast, their bearing lines fell at wrong orders and 9 of 12 inner-race and ball machines
+    # were named wrongly. Their bearing lines now contradict the speed; the speed they imply is the
+    # synthesiser's (the model has no slip: to 0.5 %, the comb's fit on 0.1 Hz lines). At the right
+    # speed the fault is named; a healthy machine at a wrong speed has no comb to contradict it
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.synth.machine(fault=fault, snr_db=0, seed=1)
+    rpm = rec.meta["rpm"]
+    assert vm.diagnose(rec, rpm=rpm, bearing="6205-2RS").top == fault
+    for factor in (0.8, 1.2):
+        d = vm.diagnose(rec, rpm=factor * rpm, bearing="6205-2RS")
+        assert d.top == "none" and d.speed.get("contradicted_by") == "bearing lines", (factor, d.reason)
+        assert d.speed["contradicting_rpm"] == pytest.approx(rpm, rel=0.005), factor
+    healthy = vm.synth.machine(fault="none", snr_db=0, seed=1)
+    d = vm.diagnose(healthy, rpm=0.8 * rpm, bearing="6205-2RS")
+    assert d.top == "none" and "speed_contradicted" not in d.flags and d.speed["estimated_rpm"] is None
+
+
 def _with_mains(rec, line_hz, amp=0.3):
     """The record plus mains pickup: a comb at line_hz and its harmonics 1-6 (amplitudes 1/k), amp x the
     record's RMS in all."""

@@ -808,7 +808,7 @@ def _bearing_rows(job: _Job, f1: float, speed: dict):
         {job.fs / f["spike_interval_samples"] for f in job.quality.values() if "spike_interval_samples" in f}))
     ev = bearing_evidence(job.signals, job.fs, f1, freqs, job.bearing.n_balls, band=job.band,
                           shaft_hz=shaft, f1_known=speed["estimated_rpm"] is not None, whitening=job.prewhitening,
-                          artefact_hz=glitch)
+                          artefact_hz=glitch, speed_search=SPEED_SEARCH)
     rows = []
     for name, s in ev["families"].items():
         lines = [f"{ln['hz']:.1f} Hz {ln['db']:.0f} dB" for ln in s["lines"] if ln["r"] >= 6.0]
@@ -964,7 +964,11 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     The 1X is looked for within 12 % of ``rpm``. When the record contradicts the declared speed (a
     shaft comb stands elsewhere, 10 dB above the 1X candidate and with more harmonics, in any channel),
     the flag is ``speed_contradicted``, ``speed["contradicting_rpm"]`` says where the comb stands, and
-    no shaft-order or bearing fault is looked for ("none", ``bearing_checked`` False).
+    no shaft-order or bearing fault is looked for ("none", ``bearing_checked`` False). Where no 1X line
+    confirms the declared speed, the bearing's own lines can contradict it too: a fault comb that
+    stands where another speed (0.5-2 x) puts it, far stronger than any at the declared speed
+    (``bearing_faults.speed_scan``; ``speed["contradicted_by"]`` is then "bearing lines" and
+    ``speed["bearing_comb"]`` holds the comb).
     """
     from . import shaft_faults as sf
     rec = as_record(rec, fs=fs)
@@ -1022,6 +1026,9 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     contradicted = "speed_contradicted" in job.flags
     b_rows, ev = _bearing_rows(job, f1, speed) if not contradicted else ([], None)
     rows += b_rows
+    if ev is not None and ev.get("speed_scan") is not None:
+        _bearing_contradiction(job, speed, f1, ev["speed_scan"])
+        contradicted = True
     narrow = _narrow_channels(ev, job, f1) if ev is not None and job.band is None else []
     if narrow:
         job.flags.append("band_limited")
@@ -1070,6 +1077,25 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         env_band = extras["ses"]["band_hz"]
     return Diagnosis(top, conf, reason, table, speed, severity, tuple(env_band), tuple(job.flags), extras,
                      channel=str(where), bearing_checked=job.bearing is not None and not contradicted)
+
+
+def _bearing_contradiction(job: _Job, speed: dict, f1: float, other: dict):
+    """No 1X confirmed the declared speed, and the bearing's lines stand where another speed puts them
+    (``bearing_faults.speed_scan``): the speed is contradicted, as by another shaft's comb."""
+    lines = ", ".join(f"{hz:.1f} Hz {db:.0f} dB" for hz, db in other["lines"][:5])
+    speed.update(consistent=False, estimated_rpm=None, contradicting_rpm=60 * f1 * other["factor"],
+                 contradicted_by="bearing lines", bearing_comb=other, note=(
+                     f"the declared {job.rpm:g} rpm is contradicted by the bearing's lines: no 1X line confirms "
+                     f"it, and a {other['family']} comb ({other['model']}: {lines}) stands where about "
+                     f"{60 * f1 * other['factor']:.0f} rpm ({100 * (other['factor'] - 1):+.1f} %) puts it, "
+                     f"p = {other['p_value']:.2g} in {other['channel']!r} against p = "
+                     f"{other['declared_p_value']:.2g} for the best comb at the declared speed"
+                     + "".join(f"; another family's comb fits them nearly as well at {60 * f1 * u:.0f} rpm"
+                               for u in other.get("other_factors", ())[:2])
+                     + " (or the bearing declared is not the one that shows). Shaft-order and bearing faults "
+                     "are not looked for at a speed the record contradicts: give the measured speed (rpm=, or "
+                     "tach= / rpm_profile=)"))
+    job.flags.append("speed_contradicted")
 
 
 def _narrow_channels(ev, job: _Job, f1: float) -> list:
