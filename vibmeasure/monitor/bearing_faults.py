@@ -679,9 +679,10 @@ def _shaft_like(hz: list, f1: float, search: float, df: float) -> bool:
 
 
 def _declared(hz: list, freqs: dict, df: float) -> bool:
-    """Do the lines ``hz`` all stand where the declared speed puts a bearing line (a harmonic 1-10 of
-    BPFO, BPFI, BSF or 2 x BSF, within SLIP)? Such lines cannot contradict that speed."""
-    return bool(hz) and all(any(abs(h - round(h / f) * f) <= max(SLIP * h, 1.5 * df) and 1 <= round(h / f) <= 10
+    """Do the lines ``hz`` all stand where the declared speed puts a bearing line (a harmonic 1-5 of
+    BPFO, BPFI, BSF or 2 x BSF, within SLIP: the harmonics the families test)? Such lines cannot
+    contradict that speed."""
+    return bool(hz) and all(any(abs(h - round(h / f) * f) <= max(SLIP * h, 1.5 * df) and 1 <= round(h / f) <= 5
                                 for f in (freqs["BPFO"], freqs["BPFI"], freqs["BSF"], freqs["2xBSF"])) for h in hz)
 
 
