@@ -387,11 +387,12 @@ def plot_diagnosis(rec, diag, *, axes=None):
     if other is not None:   # the shaft comb that contradicts the declared speed, where it stands
         for k in range(1, 7):
             ax_s.axvline(k * other / 60, color="C3", lw=0.8, ls="--")
-        what = ("the bearing's lines stand where" if diag.speed.get("contradicted_by") == "bearing lines" else
-                "a shaft comb stands at")
-        ax_s.text(0.5, 0.9, f"WARNING: the declared {diag.speed['declared_rpm']:g} rpm is contradicted: {what} "
-                  f"{other:.0f} rpm puts them (red: its 1X-6X); no fault was looked for", transform=ax_s.transAxes,
-                  ha="center", color="C3", fontsize=9, fontweight="bold")
+        what = (f"the bearing's lines stand where {other:.0f} rpm puts them (red: that speed's 1X-6X)"
+                if diag.speed.get("contradicted_by") == "bearing lines" else
+                f"a shaft comb stands at {other:.0f} rpm (red)")
+        ax_s.text(0.5, 0.96, f"WARNING: the declared {diag.speed['declared_rpm']:g} rpm is contradicted:\n{what}; "
+                  "no fault was looked for", transform=ax_s.transAxes,
+                  ha="center", va="top", color="C3", fontsize=9, fontweight="bold")
     elif "speed_inconsistent" in diag.flags or not diag.speed.get("consistent", True):
         ax_s.text(0.5, 0.9, "WARNING: the speed check failed (see the diagnosis flags)", transform=ax_s.transAxes,
                   ha="center", color="C3", fontsize=9, fontweight="bold")

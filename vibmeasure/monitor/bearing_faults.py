@@ -690,8 +690,8 @@ def speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float) -> di
     """The bearing comb that contradicts the declared speed (see SPEED_SCAN), or None: {"factor": true
     over declared speed, "family", "model", "p_value", "declared_p_value", "lines": [(Hz, dB)], "channel",
     "preprocessing", "other_factors"}. Both sides are judged on the same lines: every spectrum after the
-    shaft's and the cage's claims (``r_base``), every family at the declared speed (its +-SLIP) against
-    every family elsewhere. A comb elsewhere whose lines are all harmonics of a speed within
+    shaft's and the cage's claims (``r_base``), every family at the declared speed (its +-SLIP, and
+    scaled anywhere within ``speed_search``) against every family elsewhere. A comb elsewhere whose lines are all harmonics of a speed within
     ``speed_search`` of the declared one is that shaft's modulation (a 1X too weak to be found), not a
     bearing's."""
     n_sp = max(1, len(spectra))
@@ -742,7 +742,7 @@ def speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float) -> di
         return None
     best["declared_p_value"] = float(np.exp(declared))
     # another family's comb at another speed may fit the same lines nearly as well (a 6205's BPFO x 1-3
-    # is its BSF x 1.5, 3, 4.5 at 1.52 x the speed): those speeds are named too
+    # is its BSF x 1-3 at 1.52 x the speed): those speeds are named too
     others = []
     for lp, c in found[1:]:
         if lp < logp - np.log(SPEED_SCAN_MARGIN) and all(abs(c["factor"] / u - 1) > 2 * SLIP
