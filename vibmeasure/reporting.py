@@ -47,8 +47,8 @@ FLAG_ADVICE = {
     "speed_varies": "record a tachometer or encoder with the vibration (tach=, --tach) or give the speed profile "
                     "(rpm_profile=), or measure at a steady speed",
     "order_tracked": "frequencies are orders x the mean speed; check the tachometer's pulses per revolution",
-    "spikes_removed": "check the cabling, connectors and converter: glitches that regular become a comb in the "
-                      "envelope spectrum",
+    "spikes_removed": "check the cabling, connectors and converter: glitches that come at regular intervals become "
+                      "a comb in the envelope spectrum",
     "dropouts": "check the acquisition chain (buffer overruns, a link that drops out) and record again",
     "saturated": "lower the sensor gain or choose a larger range: clipped samples carry no information",
 }

@@ -686,7 +686,7 @@ def _declared(hz: list, freqs: dict, df: float) -> bool:
                                 for f in (freqs["BPFO"], freqs["BPFI"], freqs["BSF"], freqs["2xBSF"])) for h in hz)
 
 
-def speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float) -> dict | None:
+def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float) -> dict | None:
     """The bearing comb that contradicts the declared speed (see SPEED_SCAN), or None: {"factor": true
     over declared speed, "family", "model", "p_value", "declared_p_value", "lines": [(Hz, dB)], "channel",
     "preprocessing", "other_factors"}. Both sides are judged on the same lines: every spectrum after the
@@ -760,11 +760,11 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     """Evidence per bearing family over every channel in ``signals`` (name -> array). ``artefact_hz``:
     fundamentals of combs the recording chain made (spikes every P samples: fs / P), whose lines are
     claimed before anything else. ``speed_search``: how far (a share of f1) the caller looked for the 1X;
-    given, and with ``f1_known`` False, the bearing's lines are searched at other speeds (``speed_scan``).
+    given, and with ``f1_known`` False, the bearing's lines are searched at other speeds (``_speed_scan``).
 
     Returns {"families": {name: summary}, "spectra": [_SES], "kurtogram": Kurtogram of the first channel,
     "n_spectra": int, "measured_top_hz": {channel: upper edge of the band it measures}, "speed_scan": the
-    comb that contradicts the declared speed (``speed_scan``), else None}. Each summary
+    comb that contradicts the declared speed (``_speed_scan``), else None}. Each summary
     holds p_value, log10_p, confidence, slip, found_hz, lines, sidebands, channel, preprocessing,
     band_hz, found (bool).
     """
@@ -822,7 +822,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     for n in names:
         fams[n]["not_called"] = _not_called(n, fams[n], n_sp, n_views)
     # no 1X confirms the declared speed: do the bearing's lines stand where another speed puts them?
-    other = None if f1_known or speed_search is None else speed_scan(spectra, freqs, f1, speed_search)
+    other = None if f1_known or speed_search is None else _speed_scan(spectra, freqs, f1, speed_search)
     return {"families": fams, "spectra": spectra, "kurtogram": kg, "n_spectra": n_sp, "measured_top_hz": measured,
             "speed_scan": other}
 

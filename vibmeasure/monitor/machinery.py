@@ -967,7 +967,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     no shaft-order or bearing fault is looked for ("none", ``bearing_checked`` False). Where no 1X line
     confirms the declared speed, the bearing's own lines can contradict it too: a fault comb that
     stands where another speed (0.5-2 x) puts it, far stronger than any at the declared speed
-    (``bearing_faults.speed_scan``; ``speed["contradicted_by"]`` is then "bearing lines" and
+    (``bearing_faults._speed_scan``; ``speed["contradicted_by"]`` is then "bearing lines" and
     ``speed["bearing_comb"]`` holds the comb).
     """
     from . import shaft_faults as sf
@@ -1081,7 +1081,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
 
 def _bearing_contradiction(job: _Job, speed: dict, f1: float, other: dict):
     """No 1X confirmed the declared speed, and the bearing's lines stand where another speed puts them
-    (``bearing_faults.speed_scan``): the speed is contradicted, as by another shaft's comb."""
+    (``bearing_faults._speed_scan``): the speed is contradicted, as by another shaft's comb."""
     lines = ", ".join(f"{hz:.1f} Hz {db:.0f} dB" for hz, db in other["lines"][:5])
     speed.update(consistent=False, estimated_rpm=None, contradicting_rpm=60 * f1 * other["factor"],
                  contradicted_by="bearing lines", bearing_comb=other, note=(
