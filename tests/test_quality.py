@@ -51,6 +51,50 @@ def test_a_regular_spike_train_is_found_whole_on_its_grid(rng):
     np.testing.assert_array_equal(q.isolated_spikes(y), idx)
 
 
+def test_the_ar_fill_reaches_the_interpolation_error_of_the_true_model():
+    """Oracle: for an AR(2) process (a resonance at 0.2 fs driven by white noise of spread s), the
+    least-squares interpolation of one missing sample from the true model misses it with spread
+    s / sqrt(1 + a1^2 + a2^2) (Janssen et al. 1986). The fill fits its own AR(32) model on the record:
+    its errors over 400 isolated samples match that within 10 % (the sampling spread of 400 errors is
+    3.5 %); the neighbours' mean misses by 2.5 times more."""
+    from scipy.signal import lfilter
+    rng = np.random.default_rng(11)
+    r, th = 0.95, 2 * np.pi * 0.2
+    a1, a2 = 2 * r * np.cos(th), -r * r
+    x = lfilter([1.0], [1.0, -a1, -a2], rng.normal(size=200_000))
+    idx = np.sort(rng.choice(np.arange(100, x.size - 100, 50), 400, replace=False))
+    y = x.copy()
+    y[idx] = 1e3    # the samples lost
+    err = q.fill(y, idx)[idx] - x[idx]
+    oracle = 1.0 / np.sqrt(1 + a1 ** 2 + a2 ** 2)
+    assert np.std(err) == pytest.approx(oracle, rel=0.10)
+    assert np.std(q._repair(y, idx)[idx] - x[idx]) > 2 * oracle   # measured: 2.5 x
+    # two adjacent samples are filled jointly: still a fraction of the signal's spread
+    pair = np.array([5000, 5001])
+    y2 = x.copy()
+    y2[pair] = [1e3, -1e3]
+    assert np.max(np.abs(q.fill(y2, pair)[pair] - x[pair])) < 0.5 * x.std()
+
+
+def test_glitches_on_impacts_and_over_two_samples_are_found(rng):
+    """Spikes of 30 x the RMS on the impacts of a bearing fault (where the ringing hides them from the
+    median's residual: the AR model's second look finds them) and two-sample glitches of alternating
+    sign (a seam): all found, and nothing else."""
+    x = _machine("bearing_outer_race", snr_db=20).data[0].astype(float)
+    assert q.isolated_spikes(x).size == 0
+    r = np.abs(x)
+    peaks = np.flatnonzero((r > 4 * x.std()) & (r >= np.roll(r, 1)) & (r >= np.roll(r, -1)))
+    peaks = peaks[(peaks > 100) & (peaks < x.size - 100)]
+    on_impacts = rng.choice(peaks, 10, replace=False) + 2
+    pairs = np.array([30_000, 50_000, 60_000])
+    y = x.copy()
+    y[on_impacts] += 30 * x.std() * np.sign(x[on_impacts])
+    y[pairs] += 20 * x.std()
+    y[pairs + 1] -= 20 * x.std()
+    want = np.sort(np.concatenate((on_impacts, pairs, pairs + 1)))
+    np.testing.assert_array_equal(q.isolated_spikes(y), want)
+
+
 def test_an_impact_ringing_near_nyquist_is_no_spike():
     """A decaying tone at 0.45 fs (2 % damping) 40 x the noise: every other sample is far out, so the
     candidates make a burst; and a 0.3 % wiggle on a smooth, oversampled ring-down is no spike (it
@@ -90,6 +134,28 @@ def test_no_spike_on_any_channel_of_the_real_recordings(shared_data):
     assert saturated == [("OR007@12_0.mat", "X302_FE_time", 23)]
 
 
+def test_random_spikes_on_a_real_fault_record_are_found_and_nothing_else(shared_data, monkeypatch):
+    """500 single-sample spikes of 30 x the RMS, alternating sign, in 10 s of CWRU fan-end OR007@6_2's
+    fan-end channel (outer-race impacts ringing at 2-4 kHz of 12 kHz): at most 1 % missed (measured:
+    none with seed 3, 4 with seed 4: pairs beside an impact) and no sample of the vibration taken. The
+    median's residual alone misses 13 with seed 3: those on impacts, which the AR model's second look
+    (``_ar_spikes``) finds. (Over every channel of the 53 fault records: 191 of 69,351 missed without
+    it, 27 with it.)"""
+    m = sio.loadmat(shared_data("cwru_fe") / "OR007@6_2.mat", squeeze_me=True)
+    x = np.asarray(m["X296_FE_time"], float)
+    for seed in (3, 4):
+        idx = np.sort(np.random.default_rng(seed).choice(x.size - 1, size=int(50 * x.size / 12000), replace=False))
+        y = x.copy()
+        y[idx] += 30 * x.std() * np.where(np.arange(idx.size) % 2, 1.0, -1.0)
+        found = q.isolated_spikes(y)
+        assert np.setdiff1d(found, idx).size == 0
+        assert np.setdiff1d(idx, found).size <= 0.01 * idx.size
+        if seed == 3:
+            monkeypatch.setattr(q, "_ar_spikes", lambda y, sigma: np.zeros(0, np.int64))
+            assert np.setdiff1d(idx, q.isolated_spikes(y)).size >= 10
+            monkeypatch.undo()
+
+
 def test_despike_repairs_and_says_so():
     rec = _machine("bearing_outer_race")
     x = rec.data[0].astype(float)
@@ -98,10 +164,11 @@ def test_despike_repairs_and_says_so():
     bad = vm.Record.from_array(y, fs=rec.fs, names=["acc"], unit="g")
     with pytest.warns(vm.QualityWarning, match="channel 'acc': 2 isolated spikes replaced"):
         fixed = vm.despike(bad)
-    for i in (1000, 20000):
-        assert fixed.data[0, i] == pytest.approx(0.5 * (y[i - 1] + y[i + 1]), rel=1e-12)
-    # the repair is the neighbours' mean: off the true sample by the curvature there, far below the spike
-    assert np.max(np.abs(fixed.data[0] - x)) < 3 * x.std()
+    # the repair is the AR interpolation (``fill``): nothing else moves, and each repaired sample is
+    # off the true one by about the white noise's spread (this record is at 0 dB: half its power is
+    # noise no model predicts), far below the spike
+    assert np.array_equal(np.delete(fixed.data[0], [1000, 20000]), np.delete(y, [1000, 20000]))
+    assert np.max(np.abs(fixed.data[0] - x)) < 2 * x.std()
     assert "despike" in fixed.history[-1]
     clean = vm.Record.from_array(x, fs=rec.fs, names=["acc"], unit="g")
     with warnings.catch_warnings():
@@ -180,6 +247,30 @@ def test_diagnose_reports_dropouts_and_saturation():
     assert d.severity["lower_bound"] and "lower bound" in d.severity["note"]
     assert d.severity["velocity_rms_mm_s"] < clean.severity["velocity_rms_mm_s"]
     assert "lower_bound" not in clean.severity
+
+
+def _dropped(rec, seed=5):
+    """Ten runs of zeros of 10 ms at random places in every channel (as benchmarks/diagnosis_robustness.py)."""
+    y = rec.data.astype(float).copy()
+    n, m = y.shape[1], int(0.01 * rec.fs)
+    for s in np.random.default_rng(seed).choice(n - m, size=int(n / rec.fs), replace=False):
+        y[:, s:s + m] = 0.0
+    return vm.Record.from_array(y, fs=rec.fs, names=list(rec.names), unit="g")
+
+
+@pytest.mark.parametrize("name, truth", [("B014_3", "bearing_ball"), ("OR007@3_3", "bearing_outer_race"),
+                                         ("B021_3", "none")])
+def test_dropouts_are_filled_before_the_envelope_analysis(shared_data, name, truth):
+    """A dropout is lost data, and the runs of zeros gate the envelope: left as zeros, B014_3 (ball)
+    and OR007@3_3 (outer race) lost their right calls and B021_3 (ball, "none" as recorded) was called
+    outer race. Filled by the AR interpolation (``quality.fill``), each keeps its answer as recorded;
+    the dropouts are still flagged and counted."""
+    rec = vm.read(shared_data(f"cwru_fe/{name}.mat"), fs=12000, unit="g")
+    with pytest.warns(vm.QualityWarning, match="10 dropouts"):
+        d = vm.diagnose(_dropped(rec), rpm=rec.meta["rpm"], bearing="6203-2RS")
+    assert d.top == truth, d.reason
+    assert "dropouts" in d.flags
+    assert all(v["dropouts"] == 10 for v in d.extras["data_quality"].values())
 
 
 def test_the_command_line_prints_the_damage_as_a_warning(tmp_path):

@@ -38,10 +38,10 @@ FLAG_TEXT = {
                     "smear and no shaft-order fault is called",
     "order_tracked": "the speed varies: the record was resampled at equal steps of shaft angle and analysed in "
                      "orders",
-    "spikes_removed": "isolated spikes (single samples far from both neighbours, which no accelerometer behind an "
-                      "anti-alias filter makes) were replaced by the mean of their neighbours",
+    "spikes_removed": "isolated spikes (single samples, or two, far from their neighbours, which no accelerometer "
+                      "behind an anti-alias filter makes) were replaced by their AR interpolation",
     "dropouts": "runs of equal samples (a converter or link that held or zeroed its output): the vibration "
-                "there is lost",
+                "there is lost; they were filled by AR interpolation for the envelope analysis",
     "saturated": "runs of samples sit at the record's extremes: the sensor or converter saturated, the level "
                  "reads low and the clipping adds harmonics",
 }
