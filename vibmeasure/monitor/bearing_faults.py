@@ -163,6 +163,15 @@ def _positions(f0, harmonics, side, s):
     return H * f0 * (1 + s[:, None]) + K * sp, terms
 
 
+def _best(vals: np.ndarray, n_t: int, m_eff: int, shape: float):
+    """The comb statistic of each candidate row of line values (ratios to the floor, each capped at
+    R_CAP), the best row and its log p-value: n_t terms, each with 2 bins looked at, m_eff independent
+    placements searched; ``shape``: channels averaged (Gamma(shape) per line under noise)."""
+    T = np.minimum(vals, R_CAP).sum(axis=1) + 1e-9 * vals.sum(axis=1)  # ties: the stronger lines
+    j = int(np.argmax(T))
+    return T, j, np.log(m_eff) + n_t * np.log(2.0) + _log_gamma_sf(float(T[j]) * shape, n_t * shape)
+
+
 def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
     """Best common slip for a comb and its log p-value; None when fewer than 2 terms fit the SES."""
     df = ses.freq[1]
@@ -179,11 +188,8 @@ def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
     b = np.clip(pos / df, 1, ses.n_valid - 2)
     i0 = b.astype(np.int64)
     vals = np.maximum(ses.r[i0], ses.r[i0 + 1])
-    T = np.minimum(vals, R_CAP).sum(axis=1) + 1e-9 * vals.sum(axis=1)  # ties: the stronger lines
-    j = int(np.argmax(T))
     n_t = len(terms)
-    m_eff = int(2 * slip * top / df) + 1
-    logp = np.log(m_eff) + n_t * np.log(2.0) + _log_gamma_sf(float(T[j]) * ses.shape, n_t * ses.shape)
+    T, j, logp = _best(vals, n_t, int(2 * slip * top / df) + 1, ses.shape)
     lines = [{"harmonic": float(h), "sideband": int(k), "hz": float(p), "r": float(v)}
              for (h, k), p, v in zip(terms, pos[j], vals[j])]
     carriers = [v for (h, k), v in zip(terms, vals[j]) if k == 0]
@@ -657,13 +663,9 @@ def _scan_comb(ses: _SES, f0: float, harmonics, side, lo: float, hi: float, excl
     i0 = np.clip(b, 1, ses.n_valid - 2).astype(np.int64)
     # a line the spectrum does not reach at that speed counts as absent (the comb keeps its shape)
     vals = np.where(b < ses.n_valid - 2, np.maximum(r[i0], r[i0 + 1]), 0.0)
-    T = np.minimum(vals, R_CAP).sum(axis=1) + 1e-9 * vals.sum(axis=1)
-    j = int(np.argmax(T))
+    T, j, logp = _best(vals, len(terms), int((hi - lo) * top / df) + 1, ses.shape)
     if j in (0, s.size - 1):   # it would fit better outside the range
         return None
-    n_t = len(terms)
-    m_eff = int((hi - lo) * top / df) + 1
-    logp = np.log(m_eff) + n_t * np.log(2.0) + _log_gamma_sf(float(T[j]) * ses.shape, n_t * ses.shape)
     return float(logp), float(1 + s[j]), vals[j], terms
 
 
