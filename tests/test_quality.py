@@ -76,6 +76,16 @@ def test_the_ar_fill_reaches_the_interpolation_error_of_the_true_model():
     assert np.max(np.abs(q.fill(y2, pair)[pair] - x[pair])) < 0.5 * x.std()
 
 
+def test_fill_names_bad_indices_and_samples():
+    x = np.sin(np.arange(1000) * 0.3)
+    for bad in ([1000], [-1], [2.5]):
+        with pytest.raises(vm.ParameterError, match="idx must be sample indices of x"):
+            q.fill(x, bad)
+    with pytest.raises(vm.ParameterError, match="NaN/inf"):
+        q.fill(np.r_[x, np.nan], [3])
+    assert np.array_equal(q.fill(x, []), x)
+
+
 def test_glitches_on_impacts_and_over_two_samples_are_found(rng):
     """Spikes of 30 x the RMS on the impacts of a bearing fault (where the ringing hides them from the
     median's residual: the AR model's second look finds them) and two-sample glitches of alternating

@@ -234,7 +234,11 @@ def fill(x, idx) -> np.ndarray:
     from scipy.sparse.linalg import spsolve
     from .whiten import _ar_coefficients
     x = _samples(x)
-    idx = np.unique(np.asarray(idx, dtype=np.int64))
+    raw = np.asarray(idx)
+    if raw.size and (raw.dtype.kind not in "iu" or raw.min() < 0 or raw.max() >= x.size):
+        raise ParameterError(f"idx must be sample indices of x (integers from 0 to {x.size - 1}), got "
+                             f"{raw.dtype} values from {raw.min()!r} to {raw.max()!r}")
+    idx = np.unique(raw.astype(np.int64).ravel())
     y = _repair(x, idx)
     p = FILL_ORDER
     inner = idx[(idx >= p) & (idx < x.size - p)]
