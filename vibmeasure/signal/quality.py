@@ -19,8 +19,8 @@ median's residual. Spikes on one grid of a fixed interval (``_grid``) are comple
 every channel of the 57 development recordings (CWRU at 12 kHz, MFPT at 48.8 kHz, impacts of faulty
 bearings included) no sample is found, even at 8 sigma and 3 x; the first false find is at 6 sigma
 and 3 x. Of 500 random spikes of 30 x the RMS in every 10 s of every channel of the 53 fault records
-(alternating sign, as ``benchmarks/diagnosis_robustness.py``), 27 of 69,351 are missed (856 of
-49,956 on the fan-end channels with one-sample tests only).
+(alternating sign, as ``benchmarks/diagnosis_robustness.py``), 27 of 69,351 are missed, 191
+without the AR model's second look.
 
 ``fill`` replaces lost samples by their least-squares AR interpolation: ``despike`` and
 ``vm.diagnose`` fill the spikes found, and ``vm.diagnose`` the dropouts too. The neighbours' mean,
@@ -162,8 +162,8 @@ def _ar_spikes(y: np.ndarray, sigma: float) -> np.ndarray:
     errors e[n..n+p] weighted by the prediction-error filter c) stands ``sigma`` times its own spread
     under the model and SPIKE_LEVEL times the record's robust spread, and explains AR_SHARE of the
     error energy of those p + 1 samples. A vibration's impact is one large prediction error followed
-    by its predictable ringing: a one-sample error explains 1 / sum(c^2) of it (1.5-5 on the CWRU and
-    MFPT channels). On every channel of the 57 development recordings no sample reaches 0.78 with
+    by its predictable ringing: a one-sample error explains 1 / sum(c^2) of it (sum(c^2) is 1.5-5 on
+    the CWRU and MFPT channels). On every channel of the 57 development recordings no sample reaches 0.78 with
     sigma 8; the random spikes of 30 x the RMS the median's residual misses on impacts reach 0.98-1.0
     (two in adjacent samples do not: 0.3-0.8, and stay)."""
     from scipy.signal import oaconvolve
