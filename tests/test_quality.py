@@ -84,6 +84,22 @@ def test_fill_names_bad_indices_and_samples():
     with pytest.raises(vm.ParameterError, match="NaN/inf"):
         q.fill(np.r_[x, np.nan], [3])
     assert np.array_equal(q.fill(x, []), x)
+    with pytest.raises(vm.ParameterError, match="x has 0 samples"):
+        q.fill(np.zeros(0), [0])
+
+
+def test_a_record_that_is_only_a_spike_is_refused_not_modelled():
+    """Zeros with one spike: no AR model exists (no variation once the spike is filled); the spike is
+    found and filled with the neighbours' mean, and diagnose refuses the channel by name instead of
+    failing deep inside (a LinAlgError, then a NaN band edge)."""
+    z = np.r_[np.zeros(60_000), 5.0, np.zeros(60_000)]
+    np.testing.assert_array_equal(q.isolated_spikes(z), [60_000])
+    assert np.array_equal(q.fill(z, [60_000]), np.zeros(z.size))
+    assert np.array_equal(q.fill(np.ones(1000), [500]), np.ones(1000))
+    with pytest.warns(vm.QualityWarning):
+        assert not vm.despike(vm.Record.from_array(z, fs=12000.0)).data.any()
+    with pytest.raises(vm.ParameterError, match="channel 'acc' is constant once the recording chain's damage"):
+        vm.diagnose(vm.Record.from_array(z, fs=12000.0, names=["acc"], unit="g"), rpm=1797, bearing="6205-2RS")
 
 
 def test_glitches_on_impacts_and_over_two_samples_are_found(rng):

@@ -122,6 +122,9 @@ def _accel(rec, i, flags, quality):
     x = clean_signal(rec, i, min_samples=256)
     ch = rec.channels[i]
     x = _damage(x, rec.fs, ch.name, flags, quality)
+    if not np.ptp(x) > 0:
+        raise ParameterError(f"channel {ch.name!r} is constant once the recording chain's damage is repaired "
+                             f"({_quality_note({ch.name: quality[ch.name]})}): there is no vibration to analyse")
     if ch.unit and ch.quantity == "acceleration":
         x = _units.convert(x, ch.unit, "m/s^2")
     elif "unit_unknown" not in flags:

@@ -153,6 +153,20 @@ def _spikes_once(x: np.ndarray, sigma: float, isolation: float) -> np.ndarray:
     return single[(a[single] > isolation * around) & (others <= 1)].astype(np.int64)
 
 
+def _prediction_filter(y: np.ndarray) -> np.ndarray | None:
+    """The prediction-error filter [1, -a1, ..., -ap] of an AR(FILL_ORDER) model of y, or None when y
+    does not vary (a constant record, zeros with a spike: the model is undetermined)."""
+    from scipy.linalg import LinAlgError
+    from .whiten import _ar_coefficients
+    if not np.ptp(y) > 0:
+        return None
+    try:
+        a = _ar_coefficients(y, FILL_ORDER)
+    except (LinAlgError, ValueError):
+        return None
+    return np.concatenate(([1.0], -a)) if np.isfinite(a).all() else None
+
+
 AR_SHARE = 0.9   # a spike explains this share of the AR prediction error over the FILL_ORDER + 1 samples it enters
 
 
@@ -167,9 +181,10 @@ def _ar_spikes(y: np.ndarray, sigma: float) -> np.ndarray:
     sigma 8; the random spikes of 30 x the RMS the median's residual misses on impacts reach 0.98-1.0
     (two in adjacent samples do not: 0.3-0.8, and stay)."""
     from scipy.signal import oaconvolve
-    from .whiten import _ar_coefficients
     p = FILL_ORDER
-    c = np.concatenate(([1.0], -_ar_coefficients(y, p)))
+    c = _prediction_filter(y)
+    if c is None:
+        return np.zeros(0, np.int64)
     r0 = float(c @ c)
     e = oaconvolve(y - y.mean(), c)[: y.size]
     e[:p] = 0.0                                            # the filter's start-up
@@ -225,26 +240,29 @@ def fill(x, idx) -> np.ndarray:
     and Vries, 1986, for one missing sample at a time): the values that make the prediction error of an
     AR(FILL_ORDER) model of the record smallest over every error they enter, found jointly for samples
     within FILL_ORDER of each other. The mean of the two neighbours misses a sample of a vibration
-    record by more than its RMS (1.3-1.6 x on the CWRU fan-end channels, whose energy lies at 2-4 kHz
+    record by more than its RMS (1.3-1.8 x on the CWRU fan-end records, whose energy lies at 2-4 kHz
     of 6 kHz): 500 such repairs in 10 s spread broadband noise that whitening lifts over the bearing's
-    resonance band. The AR fill misses by 0.17-0.29 x the RMS there. Samples within FILL_ORDER of the
+    resonance band. The AR fill misses by 0.15-0.29 x the RMS there. Samples within FILL_ORDER of the
     record's ends keep the neighbours' mean; a record shorter than 8 x FILL_ORDER is filled that way."""
     from scipy.signal import oaconvolve
     from scipy.sparse import coo_matrix
     from scipy.sparse.linalg import spsolve
-    from .whiten import _ar_coefficients
     x = _samples(x)
     raw = np.asarray(idx)
-    if raw.size and (raw.dtype.kind not in "iu" or raw.min() < 0 or raw.max() >= x.size):
-        raise ParameterError(f"idx must be sample indices of x (integers from 0 to {x.size - 1}), got "
-                             f"{raw.dtype} values from {raw.min()!r} to {raw.max()!r}")
+    if raw.size and raw.dtype.kind not in "iu":
+        raise ParameterError(f"idx must be sample indices of x (integers), got {raw.dtype} values")
+    if raw.size and (raw.min() < 0 or raw.max() >= x.size):
+        raise ParameterError(f"idx must be sample indices of x (from 0 to {x.size - 1}; x has {x.size} "
+                             f"samples), got values from {int(raw.min())} to {int(raw.max())}")
     idx = np.unique(raw.astype(np.int64).ravel())
     y = _repair(x, idx)
     p = FILL_ORDER
     inner = idx[(idx >= p) & (idx < x.size - p)]
     if inner.size == 0 or x.size < 8 * p:
         return y
-    c = np.concatenate(([1.0], -_ar_coefficients(y, p)))
+    c = _prediction_filter(y)
+    if c is None:       # a record without variation (constant around the lost samples): nothing to model
+        return y
     m = float(y.mean())
     e = oaconvolve(y - m, c)[: x.size]                    # prediction error with the first repair
     g = oaconvolve(e, c[::-1])[p: p + x.size][inner]      # its gradient at each filled sample: sum_k c_k e[n + k]
