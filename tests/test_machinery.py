@@ -425,6 +425,29 @@ def test_bearing_lines_contradict_a_declared_speed_no_1x_confirms(shared_data):
     json.dumps(d.to_dict(), allow_nan=False)   # the comb's figures go out with --json
 
 
+def test_a_1x_candidate_without_harmonics_off_the_declared_speed_does_not_confirm_it(shared_data):
+    # MFPT's inner-race record declared 20 % fast: a 12 dB line at 1919 rpm (+6.6 % from the declared
+    # 1800, +28 % from the true speed) with one of its harmonics 2X-6X is the best 1X candidate. Taken as
+    # the speed, it put BPFI - 2X and its kin on the ball family, and ball was called (p = 3e-15). Off the
+    # declared speed by more than 1 % and without two harmonics it confirms nothing: the inner race's comb
+    # with its +-1X sidebands stands where the true speed puts it (to 1 %, the rolling elements' slip)
+    import scipy.io as sio
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    f = shared_data("mfpt/InnerRaceFault_vload_2.mat")
+    rpm = 60 * float(sio.loadmat(f, squeeze_me=True)["bearing"]["rate"].item())
+    rec = vm.read(f, channels=["bearing.gs"], unit="g")
+    true = vm.diagnose(rec, rpm=rpm, bearing="MFPT").speed["estimated_rpm"]
+    d = vm.diagnose(rec, rpm=1.2 * rpm, bearing="MFPT")
+    assert d.top == "none" and d.speed["contradicted_by"] == "bearing lines", d.reason
+    assert d.speed["bearing_comb"]["family"] == "bearing_inner_race"
+    assert d.speed["contradicting_rpm"] == pytest.approx(true, rel=0.01)
+    assert "speed_corrected" not in d.flags and "1X candidate, at 1919 rpm, shows 1 of its harmonics" in d.reason
+    # a 1X off the declared speed with its harmonics still gives the speed: CWRU's, declared 10 % fast
+    cw = vm.read(shared_data("cwru_fe/IR007_0.mat"), fs=12000, unit="g")
+    d = vm.diagnose(cw, rpm=1.1 * cw.meta["rpm"], bearing="6203-2RS")
+    assert d.top == "bearing_inner_race" and "speed_corrected" in d.flags and d.speed["one_x_harmonics"] >= 2
+
+
 @pytest.mark.parametrize("fault", ["bearing_outer_race", "bearing_inner_race", "bearing_ball"])
 def test_a_synthetic_bearing_fault_at_a_wrong_speed_is_not_named(fault):
     # the synthesiser's machines have a 1X without harmonics, which contradicts no wrong speed: declared

@@ -758,11 +758,13 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float) -> d
 
 def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: int, *, band=None,
                      shaft_hz: float | None = None, f1_known: bool = True, whitening=("cepstral",),
-                     artefact_hz=(), speed_search: float | None = None) -> dict:
+                     artefact_hz=(), speed_search: float | None = None, speed_confirmed: bool | None = None) -> dict:
     """Evidence per bearing family over every channel in ``signals`` (name -> array). ``artefact_hz``:
     fundamentals of combs the recording chain made (spikes every P samples: fs / P), whose lines are
     claimed before anything else. ``speed_search``: how far (a share of f1) the caller looked for the 1X;
-    given, and with ``f1_known`` False, the bearing's lines are searched at other speeds (``_speed_scan``).
+    given, and unless ``speed_confirmed`` (default ``f1_known``: a 1X was found), the bearing's lines are
+    searched at other speeds (``_speed_scan``). A 1X found off the declared speed without its harmonics
+    gives f1 but does not confirm it (``machinery.ONE_X_CONFIRMS``).
 
     Returns {"families": {name: summary}, "spectra": [_SES], "kurtogram": Kurtogram of the first channel,
     "n_spectra": int, "measured_top_hz": {channel: upper edge of the band it measures}, "speed_scan": the
@@ -824,7 +826,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     for n in names:
         fams[n]["not_called"] = _not_called(n, fams[n], n_sp, n_views)
     # no 1X confirms the declared speed: do the bearing's lines stand where another speed puts them?
-    other = None if f1_known or speed_search is None else _speed_scan(spectra, freqs, f1, speed_search)
+    confirmed = f1_known if speed_confirmed is None else speed_confirmed
+    other = None if confirmed or speed_search is None else _speed_scan(spectra, freqs, f1, speed_search)
     return {"families": fams, "spectra": spectra, "kurtogram": kg, "n_spectra": n_sp, "measured_top_hz": measured,
             "speed_scan": other}
 
