@@ -279,11 +279,12 @@ SPEED_NOTED = 0.01   # a 1X this far from the declared speed is said so in the a
 # A 1X candidate more than SPEED_NOTED from the declared speed confirms the speed it shows only with at
 # least ONE_X_CONFIRMS of its harmonics 2X-6X; with fewer, neither it nor the declared speed is confirmed
 # and the bearing's own lines are searched at other speeds, as when no 1X is found. MFPT's inner-race
-# record declared 20 % fast: a 12 dB line with no harmonic at 1919 rpm (+6.6 % from the declared 1800,
+# record declared 20 % fast: a 12 dB line with one harmonic at 1919 rpm (+6.6 % from the declared 1800,
 # +28 % from the true speed) was taken for the 1X, and ball was called at p = 3e-15 on lines of the
 # inner race; now its comb with +-1X sidebands stands at 1488 rpm (true: 1486), p = 2e-58, and the speed
-# is contradicted. Every development record and 36 robustness variant keeps its answer otherwise (the
-# 1X of the MFPT records at their declared speed has 1-3 harmonics, within 1.2 % of it).
+# is contradicted. Every development record keeps its answer, and of the 36 robustness variants only
+# that one changes (the 1X of the MFPT records at their declared speed has 1-3 harmonics, within 1.2 %
+# of it). A speed measured by a tachometer or a profile is confirmed as it is.
 ONE_X_CONFIRMS = 2
 
 
@@ -804,10 +805,14 @@ def _severity(job: _Job, f, rpm, electrical_hz=(), electrical_amp=()):
 
 
 def _confirmed(speed: dict) -> bool:
-    """Whether a 1X line confirms the speed the bearing analysis uses (see ONE_X_CONFIRMS); when none
-    does, the bearing's own lines are searched at other speeds (``bearing_faults._speed_scan``)."""
+    """Whether the speed the bearing analysis uses is confirmed: measured (a tachometer, a speed profile,
+    the 1X's own curve: ``speed["source"]``), or a 1X line near the declared speed or with its harmonics
+    (see ONE_X_CONFIRMS). When it is not, the bearing's own lines are searched at other speeds
+    (``bearing_faults._speed_scan``)."""
     if speed["estimated_rpm"] is None:
         return False
+    if speed.get("source") is not None or not speed.get("declared_rpm"):
+        return True
     off = abs(speed["estimated_rpm"] / speed["declared_rpm"] - 1)
     return off <= SPEED_NOTED or speed.get("one_x_harmonics", 0) >= ONE_X_CONFIRMS
 
