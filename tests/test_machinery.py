@@ -448,6 +448,21 @@ def test_a_1x_candidate_without_harmonics_off_the_declared_speed_does_not_confir
     assert d.top == "bearing_inner_race" and "speed_corrected" in d.flags and d.speed["one_x_harmonics"] >= 2
 
 
+def test_which_speeds_are_confirmed_for_the_bearing_analysis():
+    # the rule itself (ONE_X_CONFIRMS = 2): a 1X within SPEED_NOTED (1 %) of the declared speed, or one
+    # further off with two of its harmonics, confirms the speed; a measured speed (tachometer, profile, the
+    # 1X's own curve) is confirmed whatever was declared; no 1X, or one off it with fewer harmonics, is not
+    from vibmeasure.monitor.machinery import _confirmed
+    base = {"declared_rpm": 1800.0}
+    assert _confirmed(dict(base, estimated_rpm=1800 * 1.009, one_x_harmonics=0))
+    assert _confirmed(dict(base, estimated_rpm=1919.0, one_x_harmonics=2))
+    assert not _confirmed(dict(base, estimated_rpm=1919.0, one_x_harmonics=1))
+    assert not _confirmed(dict(base, estimated_rpm=1800 * 1.011))
+    assert not _confirmed(dict(base, estimated_rpm=None))
+    for source in ("tachometer", "rpm profile", "1X line"):
+        assert _confirmed(dict(base, estimated_rpm=1500.0, source=source)), source
+
+
 @pytest.mark.parametrize("fault", ["bearing_outer_race", "bearing_inner_race", "bearing_ball"])
 def test_a_synthetic_bearing_fault_at_a_wrong_speed_is_not_named(fault):
     # the synthesiser's machines have a 1X without harmonics, which contradicts no wrong speed: declared
