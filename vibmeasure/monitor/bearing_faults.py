@@ -348,6 +348,60 @@ def _claim_cage(ses: _SES, ftf: float, n_balls: int) -> dict | None:
     return res
 
 
+CAGE_NEIGHBOURS = 3   # a BPFO line is weighed against the cage comb's harmonics this many either side of it
+
+
+def _cage_floor(ses: _SES, ftf: float, n_balls: int) -> dict | None:
+    """Where the cage comb stands out, its level is the floor of the lines it shares with BPFO.
+
+    BPFO is n_balls x FTF exactly (both scale with 1 - d/D cos(contact angle)), so every BPFO harmonic
+    is also a harmonic of the cage comb. ``_claim_cage`` leaves those lines to BPFO; but a comb that
+    carries its harmonics on either side of one carries it too, and there the line is evidence for
+    the outer race only by what it stands above the comb. So, in a spectrum whose cage comb is
+    significant, the ratio at each multiple of n_balls x FTF is divided by the comb's level there: the
+    median of the ratios at the CAGE_NEIGHBOURS harmonics either side, over ln 2 (the median of
+    Exp(1)), the same estimate as the noise floor's; where that level is below the noise floor
+    nothing changes. The median, not the mean, so that one shaft line or one sideband among the
+    neighbours does not set it.
+
+    A ball defect rides with the cage into and out of the load zone: the envelope carries the cage
+    comb (CWRU drive-end B007_0: FTF x 1-21 at 5-15 dB), and its 9th and 18th harmonics, the 6205's
+    BPFO x 1-2, were called outer race at p = 8e-18. An outer-race defect's own lines stand well
+    above their cage sidebands.
+
+    Returns the cage comb's test (``_comb``) when it is significant, else None."""
+    res = _claim_cage_test(ses, ftf, n_balls)
+    if res is None:
+        return None
+    df = ses.freq[1]
+    f = ftf * (1 + res["slip"])
+    pre = ses.r.copy()
+    m = min(CAGE_NEIGHBOURS, (n_balls - 1) // 2)
+    k = n_balls
+    while (k + m) * f / df < ses.n_valid - 3:
+        nb = []
+        for j in range(1, m + 1):
+            for kk in (k - j, k + j):
+                i = int(kk * f / df)
+                nb.append(max(pre[i], pre[i + 1]))
+        level = float(np.median(nb))
+        if level > 1.0:
+            ses.r[int(np.ceil((k - 0.5) * f / df)): int(np.floor((k + 0.5) * f / df)) + 1] /= level
+        k += n_balls
+    return res
+
+
+def _claim_cage_test(ses: _SES, ftf: float, n_balls: int) -> dict | None:
+    """The cage comb's test (harmonics 1-6 that are not BPFO's) when it is significant with two lines
+    standing, else None."""
+    k_max = int((ses.n_valid - 3) * ses.freq[1] / (ftf * (1 + SLIP)))
+    ks = tuple(k for k in range(1, min(k_max, 6) + 1) if k % n_balls)
+    if len(ks) < 2:
+        return None
+    res = _comb(ses, ftf, ks)
+    return res if res and res["logp"] < np.log(ALPHA) and res["n_lines"] >= 2 else None
+
+
 def _family(ses: _SES, name: str, freqs: dict, f1: float) -> dict | None:
     key, models = FAMILIES[name]
     best = None
@@ -775,6 +829,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     spectra, measured = [], {}
     for name, x in signals.items():
         sp, measured[name] = _spectra(x, fs, name, f1, freqs, band, whitening)
+        for s in sp:   # before the channels are fused, so that a mean carries each channel's floor
+            _cage_floor(s, freqs["FTF"], n_balls)
         spectra.extend(sp)
     # the shaft claims the harmonics a bearing line could also be (``_contested``) only when one of the
     # spectra (any channel: one shaft turns under every sensor) shows it on its own, at a harmonic no
