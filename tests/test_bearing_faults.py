@@ -209,6 +209,44 @@ def test_stress_cases(kw, bearing, ok):
             assert cage.p_value < 1e-6 and cage.confidence == 0.0 and "not a fault by itself" in cage.note
 
 
+def _sharp_cage_comb(n, fs, rpm, bearing, seed, width=1 / 15):
+    """Resonance-band noise whose level pulses once per cage turn (a Gaussian pulse): its envelope is
+    a comb of FTF harmonics falling as exp(-(k width)^2 / 2), 0.83 at the 9th, 0.49 at the 18th, so
+    it carries lines at n_balls x FTF (BPFO) and its multiples as high as their neighbours."""
+    ftf = vm.BEARINGS[bearing].frequencies(rpm / 60)["FTF"]
+    rng = np.random.default_rng(seed)
+    turns = (ftf * np.arange(n) / fs + rng.uniform()) % 1.0 - 0.5
+    pulse = np.exp(-0.5 * (turns * 2 * np.pi / width) ** 2)
+    from scipy.signal import butter, sosfiltfilt
+    noise = sosfiltfilt(butter(4, [2500, 4500], "bandpass", fs=fs, output="sos"), rng.standard_normal(n))
+    x = noise * (1 + 4 * pulse)
+    return x / np.std(x)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_bpfo_lines_that_a_cage_comb_carries_are_no_outer_race(seed):
+    # BPFO is n_balls x FTF exactly, so a cage comb with many harmonics has lines at BPFO x 1, 2, 3 as
+    # high as its other harmonics. They count for the outer race only by what they stand above the
+    # comb's neighbouring harmonics (_cage_floor). Before, these healthy records gave the outer race
+    # p = 1e-7 to 1e-11 and one was called outer race; now p = 1 (measured). An outer-race fault
+    # under the same comb stands far above it and is still called (p 1e-17 to 1e-23 measured).
+    fs, rpm, n = 20000.0, 1797.0, 120000
+    comb = _sharp_cage_comb(n, fs, rpm, "6205-2RS", seed)
+    for fault, share, ok in (("none", 0.3, "none"), ("bearing_outer_race", 1.0, "bearing_outer_race")):
+        base = vm.synth.machine(fault=fault, rpm=rpm, fs=fs, duration=6.0, snr_db=0, bearing="6205-2RS", seed=seed)
+        x = base.data[0] + share * np.std(base.data[0]) * comb
+        d = vm.diagnose(vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="g"), rpm=rpm,
+                        bearing="6205-2RS")
+        rows = d.faults.set_index("fault")
+        assert d.top == ok, d.reason
+        assert rows.loc["bearing_cage"].p_value < 1e-20   # the comb itself is plain (measured 1e-22 to 1e-41)
+        outer = rows.loc["bearing_outer_race"]
+        if ok == "none":
+            assert outer.p_value > 0.01 and "harmonics of the cage comb" in outer.note
+        else:
+            assert outer.p_value < 1e-10
+
+
 def test_a_comb_of_even_harmonics_only_is_twice_the_fundamental_and_not_that_fault():
     # a 16-roller bearing's outer-race fault (ZA-2115, BPFO 7.092 X) read with a 6205 declared (BPFO
     # 3.585 X): the ZA-2115's BPFO and its harmonics stand at the 6205's 2nd and 4th BPFO harmonics

@@ -15,7 +15,9 @@ Pipeline for one record (``bearing_evidence``):
 2. normalise: each SES power line divided by its local floor (running median / ln 2), and mapped
    through the exact law of that median (``_exact_exponential``), so that for Gaussian noise the
    ratio ``r`` is exponential with mean 1 (chi-square with 2 degrees of freedom over 2) even where
-   the floor rests on few bins (short records).
+   the floor rests on few bins (short records). Where a channel's cage comb stands out, the lines it
+   shares with BPFO (n_balls x FTF and its multiples) are divided by the comb's level beside them
+   (``_cage_floor``), before the channels are averaged.
 3. explain: lines at exact shaft harmonics (those a bearing line could also be only when a spectrum
    shows the shaft at a harmonic no bearing line explains, ``_shaft_shows``), then the cage comb (FTF
    harmonics that are not BPFO's), are claimed first; then the bearing families (BPFO; BPFI with +-1X
@@ -87,6 +89,7 @@ class _SES:
     kurtogram: object = None
     r_base: np.ndarray | None = None
     shape: int = 1               # r is the mean of this many independent spectra (Gamma(shape)/shape)
+    cage_floor: dict = field(default_factory=dict)   # multiple of n_balls x FTF -> (lo Hz, hi Hz, level)
 
     @property
     def r_line(self) -> float:
@@ -335,12 +338,9 @@ def _claim_artefact(ses: _SES, hz: float):
 def _claim_cage(ses: _SES, ftf: float, n_balls: int) -> dict | None:
     """The cage comb (FTF harmonics that are not BPFO's, which is n_balls x FTF): claimed when
     significant. Cage-rate modulation is common on healthy bearings; it is reported, not called."""
-    k_max = int((ses.n_valid - 3) * ses.freq[1] / (ftf * (1 + SLIP)))
-    ks = tuple(k for k in range(1, min(k_max, 6) + 1) if k % n_balls)
-    if len(ks) < 2:
-        return None
-    res = _comb(ses, ftf, ks)
-    if res and res["logp"] < np.log(ALPHA) and res["n_lines"] >= 2:
+    res = _cage_comb(ses, ftf, n_balls)
+    if _cage_stands(res):
+        k_max = int((ses.n_valid - 3) * ses.freq[1] / (ftf * (1 + SLIP)))
         for k in range(1, k_max + 1):
             hz = k * ftf * (1 + res["slip"])
             if k % n_balls and _line_present(ses, hz):
@@ -358,11 +358,12 @@ def _cage_floor(ses: _SES, ftf: float, n_balls: int) -> dict | None:
     is also a harmonic of the cage comb. ``_claim_cage`` leaves those lines to BPFO; but a comb that
     carries its harmonics on either side of one carries it too, and there the line is evidence for
     the outer race only by what it stands above the comb. So, in a spectrum whose cage comb is
-    significant, the ratio at each multiple of n_balls x FTF is divided by the comb's level there: the
-    median of the ratios at the CAGE_NEIGHBOURS harmonics either side, over ln 2 (the median of
-    Exp(1)), the same estimate as the noise floor's; where that level is below the noise floor
-    nothing changes. The median, not the mean, so that one shaft line or one sideband among the
-    neighbours does not set it.
+    significant, the ratios within half a cage order of each multiple of n_balls x FTF are divided by
+    the comb's level there: the median of its lines at the CAGE_NEIGHBOURS harmonics either side (the
+    typical height of the comb's lines beside it); where that level is below the noise floor nothing
+    changes. The median, not the mean, so that one shaft line or one sideband among the neighbours
+    does not set it. The whole stretch is divided, not the line's bin alone, so that the family's slip
+    search finds no untouched flank beside it.
 
     A ball defect rides with the cage into and out of the load zone: the envelope carries the cage
     comb (CWRU drive-end B007_0: FTF x 1-21 at 5-15 dB), and its 9th and 18th harmonics, the 6205's
@@ -370,13 +371,15 @@ def _cage_floor(ses: _SES, ftf: float, n_balls: int) -> dict | None:
     above their cage sidebands.
 
     Returns the cage comb's test (``_comb``) when it is significant, else None."""
-    res = _claim_cage_test(ses, ftf, n_balls)
-    if res is None:
+    res = _cage_comb(ses, ftf, n_balls)
+    if not _cage_stands(res):
         return None
     df = ses.freq[1]
     f = ftf * (1 + res["slip"])
     pre = ses.r.copy()
-    m = min(CAGE_NEIGHBOURS, (n_balls - 1) // 2)
+    m = min(CAGE_NEIGHBOURS, (n_balls - 1) // 2)   # neighbours that are no multiple of n_balls
+    if m < 1:
+        return res
     k = n_balls
     while (k + m) * f / df < ses.n_valid - 3:
         nb = []
@@ -387,19 +390,21 @@ def _cage_floor(ses: _SES, ftf: float, n_balls: int) -> dict | None:
         level = float(np.median(nb))
         if level > 1.0:
             ses.r[int(np.ceil((k - 0.5) * f / df)): int(np.floor((k + 0.5) * f / df)) + 1] /= level
+            ses.cage_floor[k] = ((k - 0.5) * f, (k + 0.5) * f, level)
         k += n_balls
     return res
 
 
-def _claim_cage_test(ses: _SES, ftf: float, n_balls: int) -> dict | None:
-    """The cage comb's test (harmonics 1-6 that are not BPFO's) when it is significant with two lines
-    standing, else None."""
+def _cage_comb(ses: _SES, ftf: float, n_balls: int) -> dict | None:
+    """The cage comb's test (``_comb``) on its harmonics 1-6 that are not BPFO's."""
     k_max = int((ses.n_valid - 3) * ses.freq[1] / (ftf * (1 + SLIP)))
     ks = tuple(k for k in range(1, min(k_max, 6) + 1) if k % n_balls)
-    if len(ks) < 2:
-        return None
-    res = _comb(ses, ftf, ks)
-    return res if res and res["logp"] < np.log(ALPHA) and res["n_lines"] >= 2 else None
+    return _comb(ses, ftf, ks) if len(ks) >= 2 else None
+
+
+def _cage_stands(res: dict | None) -> bool:
+    """Does the cage comb stand out: significant, with two lines standing?"""
+    return bool(res and res["logp"] < np.log(ALPHA) and res["n_lines"] >= 2)
 
 
 def _family(ses: _SES, name: str, freqs: dict, f1: float) -> dict | None:
@@ -665,8 +670,12 @@ def _fused(spectra: list) -> list:
         bands = {s.band for s in group}
         band = group[0].band if len(bands) == 1 else (min(b[0] for b in bands), max(b[1] for b in bands))
         label = prep + (" (channels fused)" if len(bands) == 1 else " (channels fused, each in its own band)")
+        floor: dict = {}
+        for s in group:   # the comb's level under each channel's lines, the highest of them
+            for k, v in s.cage_floor.items():
+                floor[k] = max(floor.get(k, v), v, key=lambda t: t[2])
         out.append(_SES("+".join(s.channel for s in group), label, band, group[0].freq[:n], amp, r, nv,
-                        shape=len(group)))
+                        shape=len(group), cage_floor=floor))
     return out
 
 
@@ -978,6 +987,8 @@ def _summary(name, key, res, ses, freqs, n_sp) -> dict:
     main = [ln for ln in lines if ln["sideband"] == 0]
     ev_db = float(np.mean([ln["db"] for ln in main])) if main else 0.0
     found = bool(logp < np.log(ALPHA) and _accepted(res))
+    # the cage comb's level where it carries the family's lines (BPFO's harmonics: ``_cage_floor``)
+    under = [v[2] for ln in main for v in ses.cage_floor.values() if v[0] <= ln["hz"] <= v[1]]
     return {"fault": name, "expected_hz": expected, "found": found, "log_p": logp, "p_value": float(np.exp(logp)),
             "statistic": res["stat"], "n_terms": res["n_terms"],
             "log10_p": float(logp / np.log(10)), "slip": res["slip"], "found_hz": float(f0),
@@ -986,4 +997,5 @@ def _summary(name, key, res, ses, freqs, n_sp) -> dict:
             "channel": ses.channel,
             "preprocessing": ses.prep,
             "band_hz": ses.band, "model": res.get("model"), "modulation_sidebands": res.get("modulation"),
-            "amplitude": float(ses.amp[i]) if i < ses.amp.size else None, "evidence_db": ev_db}
+            "amplitude": float(ses.amp[i]) if i < ses.amp.size else None, "evidence_db": ev_db,
+            "cage_floor_db": float(10 * np.log10(max(under))) if under else None}

@@ -850,6 +850,9 @@ def _bearing_rows(job: _Job, f1: float, speed: dict):
                     f"claimed first in {s['votes']} spectra")
         else:
             note = "no comb in any envelope spectrum"
+        if name != "bearing_cage" and s.get("cage_floor_db") is not None:
+            note += (f"; its lines are also harmonics of the cage comb, which stands up to "
+                     f"{s['cage_floor_db']:.0f} dB there: they count only by what they stand above it")
         rows.append(_row(name, s["expected_hz"], s["found_hz"], s["amplitude"], s["evidence_db"], s["confidence"],
                          note, p_value=s["p_value"], log10_p=s["log10_p"], statistic=s["statistic"],
                          n_terms=s["n_terms"], decoy_p=s.get("decoy_p"), slip=s["slip"], channel=s["channel"],
