@@ -362,8 +362,9 @@ def _cage_floor(ses: _SES, ftf: float, n_balls: int) -> dict | None:
     the comb's level there: the median of its lines at the CAGE_NEIGHBOURS harmonics either side (the
     typical height of the comb's lines beside it); where that level is below the noise floor nothing
     changes. The median, not the mean, so that one shaft line or one sideband among the neighbours
-    does not set it. The whole stretch is divided, not the line's bin alone, so that the family's slip
-    search finds no untouched flank beside it.
+    does not set it. The whole stretch is divided, not the line's bins alone: the FTF fitted on
+    harmonics 1-6 does not pin the 18th to a bin. (A line of another family inside the stretch is
+    divided too: the 6205's 2 x BPFI lies 0.7 % from its 3 x BPFO.)
 
     A ball defect rides with the cage into and out of the load zone: the envelope carries the cage
     comb (CWRU drive-end B007_0: FTF x 1-21 at 5-15 dB), and its 9th and 18th harmonics, the 6205's
