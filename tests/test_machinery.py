@@ -67,7 +67,7 @@ def test_cwru_outer_race(shared_data):
 def test_cwru_ball_record_is_no_invented_ball_fault(shared_data):
     # B007's ball fault shows no 2xBSF comb with cage sidebands in this record (data README): no ball
     # call. Its drive-end channel carries the cage comb (the ball rides with the cage through the load
-    # zone), FTF x 1-21 at 5-15 dB, whose 9th, 18th and 27th harmonics are the 6205's BPFO x 1-3: they
+    # zone), 18 of FTF x 1-21 at 5-15 dB, whose 9th, 18th and 27th harmonics are the 6205's BPFO x 1-3: they
     # were called outer race (p = 8e-18 with three channels). Counted above the comb's level, they no
     # longer stand: "none", and the outer race's note says why
     d = vm.diagnose(cwru(shared_data, "B"), bearing="6205-2RS")

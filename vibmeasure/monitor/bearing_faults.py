@@ -367,7 +367,7 @@ def _cage_floor(ses: _SES, ftf: float, n_balls: int) -> dict | None:
     divided too: the 6205's 2 x BPFI lies 0.7 % from its 3 x BPFO.)
 
     A ball defect rides with the cage into and out of the load zone: the envelope carries the cage
-    comb (CWRU drive-end B007_0: FTF x 1-21 at 5-15 dB), and its 9th and 18th harmonics, the 6205's
+    comb (CWRU drive-end B007_0: 18 of FTF x 1-21 at 5-15 dB), and its 9th and 18th harmonics, the 6205's
     BPFO x 1-2, were called outer race at p = 8e-18. An outer-race defect's own lines stand well
     above their cage sidebands.
 
