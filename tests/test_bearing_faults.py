@@ -207,6 +207,10 @@ def test_stress_cases(kw, bearing, ok):
         if kw.get("cage_modulation"):
             cage = d.faults.set_index("fault").loc["bearing_cage"]
             assert cage.p_value < 1e-6 and cage.confidence == 0.0 and "not a fault by itself" in cage.note
+            # a "none" beside it names it (a ball defect rides with the cage and makes it too)
+            assert d.top != "none" or "the cage comb stands out" in d.reason, d.reason
+        elif d.top == "none":
+            assert "cage comb" not in d.reason, d.reason
 
 
 def _sharp_cage_comb(n, fs, rpm, bearing, seed, width=1 / 15):

@@ -77,6 +77,8 @@ def test_cwru_ball_record_is_no_invented_ball_fault(shared_data):
     assert rows.loc["bearing_cage"].p_value < 1e-5   # measured 1.2e-7
     outer = rows.loc["bearing_outer_race"]
     assert outer.p_value > 0.01 and "harmonics of the cage comb" in outer.note
+    # the "none" names the cage comb: what a ball defect leaves when its 2xBSF lines do not stand out
+    assert "the cage comb stands out" in d.reason and "2 x BSF with +-FTF sidebands" in d.reason
 
 
 def test_cwru_normal_is_none_and_fs_contradiction_flagged(shared_data):
