@@ -1,6 +1,7 @@
 """Machine diagnosis on the development records when they come in another shape: resampled, low-passed,
 with an interference tone, with mains pickup (a 50 or 60 Hz comb), damaged by the recording chain
-(single-sample spikes, regular or random; dropouts; clipping; 8-bit quantisation), with added noise, cut shorter, with a wrong declared speed (1, 5 and 10 %, and
+(single-sample spikes, regular or random; dropouts; clipping; 8-bit quantisation), with a transient (a
+noise burst, a sensor's settling), with added noise, cut shorter, with a wrong declared speed (1, 5 and 10 %, and
 15, 20 and 30 %, beyond the 1X search, where the honest answer is "none": the record contradicts the speed), one
 channel alone (whole, and in 1 s pieces). Held-out recordings come from other rigs and converters, often with one sensor; a method
 that generalises keeps its answers (or says "none") and does not start making wrong calls.
@@ -82,6 +83,36 @@ def _dropouts(ms, per_second):
     return f
 
 
+def _burst(seconds, amp):
+    """One burst of Gaussian noise ``seconds`` long at ``amp`` x each channel's RMS, a third of the way in
+    (a knock on the machine, a cable touched), on every channel at once."""
+    def f(rec, rpm):
+        y = rec.data.astype(float).copy()
+        n, s = int(seconds * rec.fs), rec.n_samples // 3
+        y[:, s:s + n] += amp * y.std(axis=1, keepdims=True) * np.random.default_rng(2).normal(size=(y.shape[0], n))
+        return _rebuilt(rec, y), rpm
+    return f
+
+
+def _settling(amp, tau):
+    """An ICP sensor's bias settling: an exponential of ``amp`` x each channel's RMS at the start,
+    decaying with time constant ``tau`` seconds."""
+    def f(rec, rpm):
+        t = np.arange(rec.n_samples) / rec.fs
+        return _rebuilt(rec, rec.data + amp * rec.data.std(axis=1, keepdims=True) * np.exp(-t / tau)), rpm
+    return f
+
+
+def _gap(seconds):
+    """One dropout of ``seconds`` (zeros) in the middle of the record."""
+    def f(rec, rpm):
+        y = rec.data.astype(float).copy()
+        n = int(seconds * rec.fs)
+        y[:, rec.n_samples // 2 - n // 2: rec.n_samples // 2 - n // 2 + n] = 0.0
+        return _rebuilt(rec, y), rpm
+    return f
+
+
 def _clipped(level):
     def f(rec, rpm):
         lim = level * rec.data.std(axis=1, keepdims=True)
@@ -136,6 +167,13 @@ VARIANTS = {
     "random spikes of 30 x the RMS, 5 a second": _spikes(30.0, per_second=5),
     "random spikes of 30 x the RMS, 50 a second": _spikes(30.0, per_second=50),
     "dropouts of 10 ms, 1 a second": _dropouts(10.0, 1),
+    "one dropout of 0.5 s": _gap(0.5),
+    # transients (signal.quality.transients): gated out; a burst under 3 x the RMS is not found
+    "noise burst of 0.2 s at 10 x the RMS": _burst(0.2, 10.0),
+    "noise burst of 0.05 s at 10 x the RMS": _burst(0.05, 10.0),
+    "noise burst of 0.2 s at 3 x the RMS": _burst(0.2, 3.0),
+    "noise burst of 0.2 s at 2 x the RMS": _burst(0.2, 2.0),
+    "sensor settling, 20 x the RMS, tau 0.3 s": _settling(20.0, 0.3),
     "clipped at 3 x the RMS": _clipped(3.0),
     "quantised to 8 bits": _quantised(8),
     "noise at the record's RMS": lambda rec, rpm: (_rebuilt(rec, rec.data + np.random.default_rng(0).normal(

@@ -115,13 +115,14 @@ def _line(freq, values, f, tol, floor_halfwidth):
 
 # --- prepare ---------------------------------------------------------------------------------------
 
-def _accel(rec, i, flags, quality):
+def _accel(rec, i, flags, quality, block):
     """Channel i as float64, in m/s^2 when its unit is a known acceleration unit, with its isolated
     spikes repaired (``signal.quality``); ``quality`` (channel -> findings) collects what the samples
-    show of the recording chain's damage: spikes, dropouts, saturation."""
+    show of the recording chain's damage: spikes, dropouts, saturation, transients (judged on blocks of
+    ``block`` samples)."""
     x = clean_signal(rec, i, min_samples=256)
     ch = rec.channels[i]
-    x = _damage(x, rec.fs, ch.name, flags, quality)
+    x = _damage(x, rec.fs, ch.name, flags, quality, block)
     if not np.ptp(x) > 0:
         raise ParameterError(f"channel {ch.name!r} is constant once the recording chain's damage is repaired "
                              f"({_quality_note({ch.name: quality[ch.name]})}): there is no vibration to analyse")
@@ -134,11 +135,13 @@ def _accel(rec, i, flags, quality):
     return x
 
 
-def _damage(x, fs, name, flags, quality):
+def _damage(x, fs, name, flags, quality, block):
     """The channel with its isolated spikes and its dropouts filled in (``quality.fill``: a spike is no
     vibration, a spike train makes a comb in the envelope spectrum, and runs of zeros gate the
-    envelope); both are reported. Saturation is only reported: filling the clipped samples made one
-    more wrong call on the robustness variants (CWRU B021_3 clipped at 3 x the RMS)."""
+    envelope), and its transients gated out (``quality.transients``, ``quality.gate``: a burst or a
+    sensor's settling is no steady running, and it buries the envelope spectrum); all are reported.
+    Saturation is only reported: filling the clipped samples made one more wrong call on the robustness
+    variants (CWRU B021_3 clipped at 3 x the RMS)."""
     from ..signal import quality as q
     found = {}
     idx = q.isolated_spikes(x)
@@ -153,13 +156,19 @@ def _damage(x, fs, name, flags, quality):
         x = q.fill(x, np.concatenate([np.arange(s, e) for s, e in runs]))
         found["dropouts"] = len(runs)
         found["dropout_seconds"] = float(sum(e - s for s, e in runs) / fs)
+    runs = q.transients(x, block)
+    if runs:
+        x = q.gate(x, runs, max(1, block // 8))
+        found["transients"] = len(runs)
+        found["transient_seconds"] = float(sum(e - s for s, e in runs) / fs)
+        found["transient_share"] = float(sum(e - s for s, e in runs) / x.size)
     share = q.clipped_share(x)
     if share > 0:
         found["saturated_share"] = share
     if found:
         quality[name] = found
         for flag, key in (("spikes_removed", "spikes_removed"), ("dropouts", "dropouts"),
-                          ("saturated", "saturated_share")):
+                          ("transients_gated", "transients"), ("saturated", "saturated_share")):
             if key in found and flag not in flags:
                 flags.append(flag)
     return x
@@ -178,6 +187,10 @@ def _quality_note(quality: dict) -> str:
         if "dropouts" in f:
             parts.append(f"{f['dropouts']} dropout{'s' * (f['dropouts'] > 1)} (runs of equal samples, "
                          f"{f['dropout_seconds']:.3g} s in all, filled in)")
+        if "transients" in f:
+            parts.append(f"{f['transients']} transient{'s' * (f['transients'] > 1)} (a burst far above the "
+                         f"record's level, or a settling or step of its mean; {f['transient_seconds']:.3g} s in "
+                         "all, gated out)")
         if "saturated_share" in f:
             parts.append(f"saturated: {100 * f['saturated_share']:.2g} % of the samples sit at its extremes")
         out.append(f"channel {name!r}: " + ", ".join(parts))
@@ -216,14 +229,16 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
     _check_nyquist(rec.fs, f1, bearing, gear)
     flags: list = []
     quality: dict = {}
-    a = _accel(rec, idx, flags, quality)
+    block = max(64, int(round(2 * rec.fs / f1)))   # transients are judged on blocks of two revolutions
+    a = _accel(rec, idx, flags, quality, block)
     if channels is None:
         chosen = [i for i, c in enumerate(rec.channels) if c.quantity not in ("force", "time") and i not in skip]
     else:
         chosen = [rec.index(c) for c in ([channels] if isinstance(channels, (str, int)) else channels)]
     if idx not in chosen:
         chosen.insert(0, idx)
-    signals = {rec.channels[i].name: (a if i == idx else _accel(rec, i, flags, quality)) for i in chosen}
+    signals = {rec.channels[i].name: (a if i == idx else _accel(rec, i, flags, quality, block))
+               for i in chosen}
     if band is not None:
         from ..core._validate import check_band
         band = check_band(band, rec.fs)
@@ -778,8 +793,10 @@ def _severity(job: _Job, f, rpm, electrical_hz=(), electrical_amp=()):
     lo = 2.0 if rpm < 600 else 10.0
     sel = (f >= lo) & (f <= 1000.0)
     n = job.a.size
-    v_rms = float(np.sqrt(np.sum(np.abs(np.fft.rfft(job.a - job.a.mean())[sel] / (2 * np.pi * f[sel])) ** 2) * 2)
-                  / n) * 1e3 if sel.any() else np.nan
+    # the transients gated out (``_damage``) hold no power: the rest of the record stands for the whole
+    kept = 1.0 - job.quality.get(job.primary, {}).get("transient_share", 0.0)
+    v_rms = float(np.sqrt(np.sum(np.abs(np.fft.rfft(job.a - job.a.mean())[sel] / (2 * np.pi * f[sel])) ** 2) * 2
+                          / kept) / n) * 1e3 if sel.any() else np.nan
     hz, amp = np.asarray(electrical_hz, float), np.asarray(electrical_amp, float)
     inside = (hz >= lo) & (hz <= 1000.0)
     v_el = float(np.sqrt(np.sum((amp[inside] / (2 * np.pi * hz[inside])) ** 2) / 2)) * 1e3
