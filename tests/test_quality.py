@@ -383,8 +383,17 @@ def test_gate_sets_the_runs_to_the_mean_with_no_step(rng):
     # the step into the run is at most the last ramp weight (1 - cos(pi/51))/2 = 0.1 % of the excursion
     assert abs(y[3999] - m) <= 0.001 * abs(x[3999] - m) + 1e-12
     assert np.array_equal(q.gate(x, [], 50), x)
-    with pytest.raises(vm.ParameterError, match=r"runs must be \(start, stop\) sample pairs within x"):
-        q.gate(x, [(9000, 11_000)], 50)
+    for bad in ([(9000, 11_000)], [(5, 5)], [(1.5, 9)], [(1, 2, 3)], [7]):
+        with pytest.raises(vm.ParameterError, match=r"runs must be \(start, stop\) sample pairs within x"):
+            q.gate(x, bad, 50)
+    for bad in (-1, 2.5, True):
+        with pytest.raises(vm.ParameterError, match=f"ramp={bad!r} must be a whole number of samples, 0 or more"):
+            q.gate(x, [(10, 20)], bad)
+    with pytest.raises(vm.ParameterError, match="NaN"):
+        q.gate(np.where(np.arange(100) == 3, np.nan, 0.0), [(10, 20)], 5)
+    with pytest.raises(vm.ParameterError, match="NaN"):
+        q.transients(np.where(np.arange(100) == 3, np.nan, 0.0), 4)
+    assert q.transients(np.zeros(0), 800) == [] and q.transients(np.zeros(50_000), 800) == []   # empty, constant
     with pytest.raises(vm.ParameterError, match="block=0 must be a whole number of samples"):
         q.transients(x, 0)
     with pytest.raises(vm.ParameterError, match="block=True must be a whole number of samples"):

@@ -393,11 +393,16 @@ def gate(x, runs, ramp: int) -> np.ndarray:
     samples on each side of each run brought to it along a half cosine (no step for the spectrum to
     spread)."""
     x = _samples(x)
+    if isinstance(ramp, bool) or not isinstance(ramp, (int, np.integer)) or ramp < 0:
+        raise ParameterError(f"ramp={ramp!r} must be a whole number of samples, 0 or more")
     w = np.ones(x.size)
-    for s, e in runs:
-        if not 0 <= s < e <= x.size:
-            raise ParameterError(f"runs must be (start, stop) sample pairs within x (0 to {x.size}), got ({s}, {e})")
-        w[s:e] = 0.0
+    for run in runs:
+        ok = np.ndim(run) == 1 and len(run) == 2 and all(
+            isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in run)
+        if not ok or not 0 <= run[0] < run[1] <= x.size:
+            raise ParameterError(f"runs must be (start, stop) sample pairs within x (whole numbers, 0 <= start < "
+                                 f"stop <= {x.size}), got {run!r}")
+        w[run[0]:run[1]] = 0.0
     if w.all():
         return x.copy()
     keep = w > 0
@@ -405,7 +410,7 @@ def gate(x, runs, ramp: int) -> np.ndarray:
     if ramp > 0:
         r = 0.5 - 0.5 * np.cos(np.pi * np.arange(1, ramp + 1) / (ramp + 1))   # rising, 0 < r < 1
         for s, e in runs:
-            a, b = min(ramp, s), min(ramp, x.size - e)
+            a, b = min(ramp, int(s)), min(ramp, x.size - int(e))
             w[s - a: s] = np.minimum(w[s - a: s], r[::-1][ramp - a:])   # falling into the run
             w[e: e + b] = np.minimum(w[e: e + b], r[:b])                 # rising out of it
     return m + (x - m) * w
