@@ -32,6 +32,7 @@ ISO_SCOPE_RPM = (120.0, 15000.0)
 LINE_DB = 12.0     # a line counts as present this far above its local floor (noise maxima reach ~10 dB)
 TOP_CONFIDENCE = 0.5
 MAX_RPM = 120000.0
+TYPICAL_FTF_ORDER = 0.38  # the cage turns at about this share of the shaft speed (0.35-0.44 in vm.BEARINGS)
 SHAFT_FAULTS = ("unbalance", "misalignment", "looseness", "resonance", "electrical", "gear_mesh")
 
 
@@ -119,7 +120,7 @@ def _accel(rec, i, flags, quality, block):
     """Channel i as float64, in m/s^2 when its unit is a known acceleration unit, with its isolated
     spikes repaired (``signal.quality``); ``quality`` (channel -> findings) collects what the samples
     show of the recording chain's damage: spikes, dropouts, saturation, transients (judged on blocks of
-    ``block`` samples)."""
+    ``block`` samples: (as recorded, whitened), ``_damage``)."""
     x = clean_signal(rec, i, min_samples=256)
     ch = rec.channels[i]
     x = _damage(x, rec.fs, ch.name, flags, quality, block)
@@ -139,7 +140,9 @@ def _damage(x, fs, name, flags, quality, block):
     """The channel with its isolated spikes and its dropouts filled in (``quality.fill``: a spike is no
     vibration, a spike train makes a comb in the envelope spectrum, and runs of zeros gate the
     envelope), and its transients gated out (``quality.transients``, ``quality.gate``: a burst or a
-    sensor's settling is no steady running, and it buries the envelope spectrum); all are reported.
+    sensor's settling is no steady running, and it buries the envelope spectrum), first those the RMS
+    rule finds in windows of ``block[0]`` samples, then those the whitened signal shows in windows of
+    ``block[1]``; all are reported.
     Saturation is only reported: filling the clipped samples made one more wrong call on the robustness
     variants (CWRU B021_3 clipped at 3 x the RMS)."""
     from ..signal import quality as q
@@ -156,9 +159,14 @@ def _damage(x, fs, name, flags, quality, block):
         x = q.fill(x, np.concatenate([np.arange(s, e) for s, e in runs]))
         found["dropouts"] = len(runs)
         found["dropout_seconds"] = float(sum(e - s for s, e in runs) / fs)
-    runs = q.transients(x, block)
+    runs = q.transients(x, block[0])
     if runs:
-        x = q.gate(x, runs, max(1, block // 8))
+        x = q.gate(x, runs, max(1, block[0] // 8))
+    hidden = q.transients(x, block[1], whiten=True)   # once the loud ones are out (quality.TRANSIENT_LEVEL)
+    if hidden:
+        x = q.gate(x, hidden, max(1, block[0] // 8))
+        runs = _merged(runs + hidden)
+    if runs:
         found["transients"] = len(runs)
         found["transient_seconds"] = float(sum(e - s for s, e in runs) / fs)
         found["transient_share"] = float(sum(e - s for s, e in runs) / x.size)
@@ -172,6 +180,17 @@ def _damage(x, fs, name, flags, quality, block):
             if key in found and flag not in flags:
                 flags.append(flag)
     return x
+
+
+def _merged(runs) -> list:
+    """(start, stop) runs with the ones that overlap or touch joined, in order."""
+    out: list = []
+    for s, e in sorted(runs):
+        if out and s <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], e))
+        else:
+            out.append((s, e))
+    return out
 
 
 def _quality_note(quality: dict) -> str:
@@ -229,7 +248,10 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
     _check_nyquist(rec.fs, f1, bearing, gear)
     flags: list = []
     quality: dict = {}
-    block = max(64, int(round(2 * rec.fs / f1)))   # transients are judged on blocks of two revolutions
+    # transients are judged on blocks of two revolutions, and in the whitened signal on blocks of two
+    # turns of the cage (quality.TRANSIENT_LEVEL: a ball defect passes the load zone once a turn)
+    ftf = bearing.frequencies(f1)["FTF"] if bearing is not None else TYPICAL_FTF_ORDER * f1
+    block = (max(64, int(round(2 * rec.fs / f1))), max(64, int(round(2 * rec.fs / ftf))))
     a = _accel(rec, idx, flags, quality, block)
     if channels is None:
         chosen = [i for i, c in enumerate(rec.channels) if c.quantity not in ("force", "time") and i not in skip]
