@@ -168,7 +168,8 @@ VARIANTS = {
     "random spikes of 30 x the RMS, 50 a second": _spikes(30.0, per_second=50),
     "dropouts of 10 ms, 1 a second": _dropouts(10.0, 1),
     "one dropout of 0.5 s": _gap(0.5),
-    # transients (signal.quality.transients): gated out; a burst under 3 x the RMS is not found
+    # transients (signal.quality.transients): gated out; a burst under 3 x the RMS is found in the whitened
+    # signal (not on the MFPT records, whose structure rings in a broad band)
     "noise burst of 0.2 s at 10 x the RMS": _burst(0.2, 10.0),
     "noise burst of 0.05 s at 10 x the RMS": _burst(0.05, 10.0),
     "noise burst of 0.2 s at 3 x the RMS": _burst(0.2, 3.0),
