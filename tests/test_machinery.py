@@ -220,11 +220,15 @@ def test_without_a_unit_level_gated_faults_are_named_but_not_called(tmp_path, sh
     known = vm.diagnose(rec)
     assert known.top == "looseness" and "unit is unknown" not in known.reason
     # CWRU B007_1 (fan-end ball fault) read without a unit: its shaft harmonics make the looseness pattern
-    # at full score, which was called at 1.00 before; with unit="g" the fan-end channel is at 0.88 mm/s,
-    # zone A, and looseness scores 0.26
+    # at full score, which was called at 1.00 before (without the unit no share of the level is weighed
+    # either); with unit="g" the fan-end channel is at 0.88 mm/s, zone A, and the harmonics carry 0.1 %
+    # of its velocity power: looseness scores 0
     raw = vm.read(shared_data("cwru_fe/B007_1.mat"), fs=12000, channels=["X283_FE_time"])
     db = vm.diagnose(raw, bearing="6203-2RS")
     assert db.top == "none" and db.faults.set_index("fault").loc["looseness"].pattern == 1.0
+    withg = vm.diagnose(vm.read(shared_data("cwru_fe/B007_1.mat"), fs=12000, unit="g", channels=["X283_FE_time"]),
+                        bearing="6203-2RS")
+    assert withg.faults.set_index("fault").loc["looseness"].confidence < 0.05
     path = tmp_path / "bare.csv"
     np.savetxt(path, bare.data[0][:, None], header="acc", comments="", delimiter=",")
     from tests.test_cli import run
@@ -740,3 +744,26 @@ def test_cwru_records_run_at_a_steady_speed(shared_data):
         rec = cwru(shared_data, key)
         lo, hi, spread, p, _ = _speed_drift(rec.data[0], rec.fs, rec.meta["rpm"] / 60)
         assert spread < SPEED_DRIFT / 2 and p > 10 * DRIFT_P
+
+
+def test_shaft_harmonics_that_carry_little_of_the_level_are_no_looseness(shared_data):
+    """The ISO level gate weighs the whole velocity; a shaft-order fault must also make it. MFPT's outer
+    race at 300 lbs (zone B, 1.75 mm/s): 6 shaft harmonics above 2X stand 12 dB over a clean floor but
+    carry about 4 % of the velocity power (the bearing's impacts and the floor make the rest), so
+    looseness is weighed by 0.04 / SHAFT_SHARE (0.2): its score, 1.00 before, stays under 0.25, and a
+    knock that hid the bearing's evidence no longer makes it the answer. A synthetic looseness machine
+    at -10 dB carries 57-61 % (full weight) and is still called."""
+    import scipy.io as sio
+    from vibmeasure.monitor import shaft_faults
+    f = shared_data("mfpt/OuterRaceFault_vload_3.mat")
+    rate = float(sio.loadmat(f, squeeze_me=True)["bearing"]["rate"].item())
+    rec = vm.read(f, channels=["bearing.gs"], unit="g")
+    d = vm.diagnose(rec, rpm=60 * rate, bearing="MFPT")
+    row = d.faults.set_index("fault").loc["looseness"]
+    share = float(row.note.split("they carry ")[1].split(" %")[0]) / 100
+    assert d.top == "bearing_outer_race" and row.evidence_db >= 5   # 5 or more harmonics stand out ...
+    assert 0.01 <= share <= 0.08 and row.confidence <= share / shaft_faults.SHAFT_SHARE + 1e-9 < 0.25
+    assert d.severity["zone"] == "B"
+    loose = vm.diagnose(vm.synth.machine(fault="looseness", snr_db=-10, seed=1, duration=6.0))
+    lrow = loose.faults.set_index("fault").loc["looseness"]
+    assert loose.top == "looseness" and float(lrow.note.split("they carry ")[1].split(" %")[0]) >= 50
