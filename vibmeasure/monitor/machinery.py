@@ -969,8 +969,8 @@ def _decide(table, job: _Job):
     strongest += _cage_standing(table)
     s_shaft, s_bear = _p_none(table)
     p_none = s_shaft * s_bear
-    top_score = (f"strongest candidate {cand.fault} at score {cand.confidence:.2f}" if cand.confidence > 0
-                 else "every family scored 0")
+    top_score = (f"strongest candidate {cand.fault} at score {cand.confidence:.2f}" if cand.confidence >= 0.005
+                 else "every family scored 0.00")
     reason = (f"none: {why}{checked}" if "speed_contradicted" in job.flags else
               f"none: {why}; {top_score}{strongest}{checked}")
     if job.bearing is not None and not job.bearing_weak:
