@@ -12,16 +12,17 @@ from ..core._validate import positive
 __all__ = ["shaft_order_rows", "resonance_row", "electrical_row", "gear_row"]
 
 ORDERS = (0.5, 1, 1.5, 2, 2.5, 3, 4, 5, 6, 7, 8, 9, 10)
-# Looseness and misalignment are weighed by the share of the velocity power their own lines carry (2X and
-# up with the half orders; 1X and 2X), at full weight from this share on. The ISO level gate alone let a clean floor's small shaft harmonics through wherever something
-# else (a bearing's impacts, broadband noise) made the level: on the eight MFPT records (1.7-3.2 mm/s,
-# zones B and C) 2-6 harmonics stand 12 dB above the floor but carry 0.5-5.8 % of the velocity power,
-# and "looseness" (score up to 1.00) was the answer wherever the bearing's evidence fell short
-# (benchmarks/diagnosis_robustness.py: a knock, a noise burst). On a healthy synthetic machine with strong
-# shaft-rate impacts (a rub) 2X/1X = 1.14 made "misalignment" though 1X and 2X carry 6 %. The synthetic
-# machines' looseness carries 57-76 % (10 to -10 dB), their misalignment more; unbalance already needs its
-# 1X to carry half the velocity power and more.
-# Without the data's unit (v_rms NaN) no share is weighed: the patterns are then named, never called.
+# Looseness and misalignment are weighed by the share of the velocity power their own lines carry (2X
+# and up with the half orders; 1X and 2X), at full weight from SHAFT_SHARE on. The ISO level gate alone
+# let a clean floor's small shaft harmonics through wherever something else (a bearing's impacts,
+# broadband noise) made the level: on the eight MFPT records (1.7-3.2 mm/s, zones B and C) 2-6
+# harmonics stand 12 dB above the floor but carry 0.5-5.8 % of the velocity power, and "looseness"
+# (score up to 1.00) was the answer wherever the bearing's evidence fell short
+# (benchmarks/diagnosis_robustness.py: a knock, a noise burst). On a healthy synthetic machine with
+# strong shaft-rate impacts (a rub) 2X/1X = 1.14 made "misalignment" though 1X and 2X carry 9 %. The
+# synthetic machines' looseness carries 57-76 % (10 to -10 dB), their misalignment 46-79 %; unbalance
+# already needs its 1X to carry half the velocity power and more. Without the data's unit (v_rms NaN)
+# no share is weighed: the patterns are then named, never called.
 SHAFT_SHARE = 0.2
 
 
@@ -44,8 +45,8 @@ def shaft_order_rows(f, V, f1, v_rms, level, flags, line, row, line_db):
                 f"1X carries {frac1 * 100:.0f} % of the velocity power")]
     ratio = v2 / v1 if v1 > 0 else np.inf
     share2 = ((v1 ** 2 + v2 ** 2) / 2 * 1e6) / v_rms ** 2 if v_rms > 0 else 1.0   # 1X and 2X's share
-    rows.append(row("misalignment", 2 * f1, order[2][0], v2, order[2][2],
-                    level * np.clip((ratio - 0.5) / 0.5, 0, 1) * (order[2][2] >= line_db) * min(1.0, share2 / SHAFT_SHARE),
+    mis = level * np.clip((ratio - 0.5) / 0.5, 0, 1) * (order[2][2] >= line_db) * min(1.0, share2 / SHAFT_SHARE)
+    rows.append(row("misalignment", 2 * f1, order[2][0], v2, order[2][2], mis,
                     f"2X/1X = {ratio:.2f}; 1X and 2X carry {100 * share2:.0f} % of the velocity power"))
     harmonics = [k for k in (3, 4, 5, 6, 7, 8, 9, 10) if k in order and order[k][2] >= line_db
                  and order[k][1] > 0.1 * max(v1, 1e-300)]
