@@ -349,9 +349,10 @@ def clipped_share(x) -> float:
 #
 # A burst can bury the envelope spectrum without standing out in the RMS: an accelerometer's signal is
 # loud in its structure's resonances and quiet elsewhere, and a broadband knock fills the quiet bands,
-# which whitening lifts to full height. A 0.2 s burst at 2 x the RMS (windows at 2.2 x, under the level)
-# stands 18-25 x above the other windows of the whitened base channels of the CWRU fan-end records, and
-# took 39 right answers of 53 to 14 (the inner race of IR007_0, p = 1e-180 as recorded, had p = 1).
+# which whitening lifts to full height. A 0.2 s burst at 2 x the RMS (about sqrt(5) = 2.2 x the record's
+# RMS, under the level) stands, whitened, 5-12 x above the median window (two revolutions) on the drive-
+# and fan-end channels of the CWRU fan-end records and 8-25 x on their base channels, and took 39 right
+# answers of 53 to 14 (the inner race of IR007_0, p = 1e-180 as recorded, had p = 1).
 # ``transients(..., whiten=True)`` judges the whitened signal with the RMS rule, in windows of two turns
 # of the bearing's cage: a defect on a rolling element passes the load zone once a turn, and real
 # ball-fault records have loud stretches on that rhythm and slower (whitened windows of two revolutions
@@ -384,12 +385,16 @@ def transients(x, block: int, *, whiten: bool = False) -> list[tuple[int, int]]:
     x = _samples(x)
     if isinstance(block, bool) or not isinstance(block, (int, np.integer)) or block < 2:
         raise ParameterError(f"block={block!r} must be a whole number of samples, at least 2")
+    if not isinstance(whiten, (bool, np.bool_)):
+        raise ParameterError(f"whiten={whiten!r} must be True or False")
     if whiten:
         if x.size < 8 * block or not np.ptp(x) > 0:   # too short for _marked, or nothing to whiten
             return []
         xw, a = _whitened(x)
-        runs = [(s + a, e + a) for s, e in _marked(xw[a: x.size - a], int(block), offset=False)]
-        return [(s, x.size if e == x.size - a else e) for s, e in runs]
+        inner = x.size - 2 * a
+        # judged between the tapered ends; a run that reaches an end takes the tapered samples beyond it
+        return [(0 if s == 0 else s + a, x.size if e == inner else e + a)
+                for s, e in _marked(xw[a: x.size - a], int(block), offset=False)]
     return _marked(x, int(block), offset=True)
 
 
