@@ -227,21 +227,30 @@ def _sharp_cage_comb(n, fs, rpm, bearing, seed, width=1 / 15):
     return x / np.std(x)
 
 
+def _with_cage_comb(fault, bearing, seed, share, snr_db=0):
+    """A synthetic machine (6 s at 20 kHz, 1797 rpm) with ``_sharp_cage_comb`` added at ``share`` x its
+    RMS, diagnosed with its bearing: the diagnosis and its table indexed by fault."""
+    fs, rpm, n = 20000.0, 1797.0, 120000
+    base = vm.synth.machine(fault=fault, rpm=rpm, fs=fs, duration=6.0, snr_db=snr_db, bearing=bearing, seed=seed)
+    x = base.data[0] + share * np.std(base.data[0]) * _sharp_cage_comb(n, fs, rpm, bearing, seed)
+    d = vm.diagnose(vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="g"), rpm=rpm, bearing=bearing)
+    return d, d.faults.set_index("fault")
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_bpfo_lines_that_a_cage_comb_carries_are_no_outer_race(seed):
     # BPFO is n_balls x FTF exactly, so a cage comb with many harmonics has lines at BPFO x 1, 2, 3 as
     # high as its other harmonics. They count for the outer race only by what they stand above the
     # comb's neighbouring harmonics (_cage_floor). Before, these healthy records gave the outer race
-    # p = 1e-7 to 1e-11 and one was called outer race; now p = 1 (measured). An outer-race fault
-    # under the same comb stands far above it and is still called (p 1e-17 to 1e-23 measured).
-    fs, rpm, n = 20000.0, 1797.0, 120000
-    comb = _sharp_cage_comb(n, fs, rpm, "6205-2RS", seed)
-    for fault, share, ok in (("none", 0.3, "none"), ("bearing_outer_race", 1.0, "bearing_outer_race")):
-        base = vm.synth.machine(fault=fault, rpm=rpm, fs=fs, duration=6.0, snr_db=0, bearing="6205-2RS", seed=seed)
-        x = base.data[0] + share * np.std(base.data[0]) * comb
-        d = vm.diagnose(vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="g"), rpm=rpm,
-                        bearing="6205-2RS")
-        rows = d.faults.set_index("fault")
+    # p = 1e-7 to 1e-11 and one was called outer race; now p = 1 (measured), also with the comb as loud
+    # as the machine (share 1.0; before the cage's fundamental was refined on its harmonics up to the
+    # 24th, seed 2 was called ball there and seed 1's outer race reached p = 1e-4). An outer-race fault
+    # under a comb at 0.6 x the machine's RMS stands far above it and is still called (p 1e-22 to 1e-25
+    # measured). (With the comb as loud as the machine its lines stand only 1 + P_fault / P_comb above
+    # the comb's, and the fault is not called: p 4e-4 to 0.2 measured.)
+    for fault, share, ok in (("none", 0.3, "none"), ("none", 1.0, "none"),
+                             ("bearing_outer_race", 0.6, "bearing_outer_race")):
+        d, rows = _with_cage_comb(fault, "6205-2RS", seed, share)
         assert d.top == ok, d.reason
         assert rows.loc["bearing_cage"].p_value < 1e-20   # the comb itself is plain (measured 4e-31 to 6e-41)
         outer = rows.loc["bearing_outer_race"]
@@ -249,6 +258,57 @@ def test_bpfo_lines_that_a_cage_comb_carries_are_no_outer_race(seed):
             assert outer.p_value > 0.01 and "harmonics of the cage comb" in outer.note
         else:
             assert outer.p_value < 1e-10
+
+
+def test_cage_comb_shares_the_harmonics_where_bpfi_or_ball_lines_fall():
+    # BPFI = n (fr - FTF), so BPFI / FTF = n fr / FTF - n: for the 6203 (8 balls, FTF 0.3817 X) 12.96,
+    # 0.3 % from the 13th cage harmonic, and its multiples 25.93 and 38.89; the 6205's (9 balls, FTF
+    # 0.3983 X) 13.60, on none. BPFO's harmonics (multiples of n_balls) are the comb's own.
+    for name, shared, free in (("6203-2RS", {13, 26, 39}, {8, 12, 14, 16, 24, 40}),
+                               ("6205-2RS", set(), {9, 13, 14, 18, 27})):
+        b = vm.BEARINGS[name]
+        f1 = 30.0
+        fr = b.frequencies(f1)
+        o = {k: v / fr["FTF"] for k, v in fr.items()}
+        for k in shared:
+            h = round(k / o["BPFI"])
+            assert abs(h * o["BPFI"] / k - 1) < bf.CONTESTED   # the analytic coincidence
+        got = bf._cage_shared(45, fr, f1, b.n_balls, df=0.01)
+        assert shared <= got and not (free & got), (name, sorted(got))
+        assert not any(k % b.n_balls == 0 for k in got)
+
+
+def test_a_comb_fundamental_is_refined_on_its_standing_harmonics():
+    # lines at k x 11.4342 Hz, k = 1..24, on a flat floor; the coarse guess 0.2 % low puts the 24th
+    # 5.5 bins off. The least-squares fit of the interpolated peaks gives the fundamental back to 1e-4
+    # (a bin is 0.1 Hz: 0.004 bin at the 24th harmonic); with fewer than four lines standing, None
+    df, f_true = 0.1, 11.4342
+    r = np.ones(6000)
+    for k in range(1, 25):
+        x = k * f_true / df
+        i = int(x)
+        r[i], r[i + 1] = 1 + 30 * (1 - (x - i)), 1 + 30 * (x - i)   # the line split between two bins
+    ses = _ses(r, df)
+    f = bf._refined(ses, f_true * 0.998, list(range(1, 25)))
+    assert abs(f / f_true - 1) < 1e-4, f
+    assert bf._refined(_ses(np.ones(6000), df), f_true, list(range(1, 25))) is None
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_bpfi_carriers_on_cage_harmonics_stay_with_the_inner_race(seed):
+    # the 6203's BPFI x 1-3 fall on the cage comb's 13th, 26th and 39th harmonics (0.3 %). The comb
+    # claimed them when it stood: under a comb as loud as the machine a healthy 6203 was called outer
+    # race (seeds 0, 1), and an inner-race fault lost its carriers (BPFI x 1 claimed: -120 dB). Now the
+    # comb leaves them to the inner race and is their floor there (_cage_floor): healthy reads "none"
+    # with no inner-race comb (p = 1 measured); the fault keeps its carriers (BPFI x 1 at 14-16 dB) and is
+    # called
+    d, rows = _with_cage_comb("none", "6203-2RS", seed, 1.0)
+    assert d.top == "none", d.reason
+    assert rows.loc["bearing_inner_race"].p_value > 0.01 and rows.loc["bearing_outer_race"].p_value > 0.01
+    d, rows = _with_cage_comb("bearing_inner_race", "6203-2RS", seed, 1.0)
+    assert d.top == "bearing_inner_race", d.reason
+    first = [h for h in rows.loc["bearing_inner_race"].harmonics if h["harmonic"] == 1 and h["sideband"] == 0]
+    assert first[0]["db"] >= 10 * np.log10(bf.R_LINE), first
 
 
 def test_a_comb_of_even_harmonics_only_is_twice_the_fundamental_and_not_that_fault():
