@@ -192,6 +192,35 @@ def rigs(n):
             print("    wrong: " + "; ".join(wrong))
 
 
+def cage_combs(n):
+    """Every catalogue bearing with a cage comb of many harmonics added (``vm.synth.cage_pulsing``, at a
+    share of the machine's RMS), 6 s at 20 kHz, 1797 rpm, 0 dB: healthy (the comb at 0.3 and 1.0 x) and each
+    bearing fault (0.5 x). A healthy bearing's comb carries BPFO's harmonics (n_balls x FTF) and,
+    on most geometries, lines where BPFI or 2 x BSF fall too: none of them may be called."""
+    print(f"\ncage comb of many harmonics, every catalogue bearing ({len(vm.BEARINGS)}), 0 dB, {n} seeds: "
+          "right / none / wrong")
+    fs, rpm = 20000.0, 1797.0
+    cases = (("none", 0.3), ("none", 1.0), ("bearing_outer_race", 0.5), ("bearing_inner_race", 0.5),
+             ("bearing_ball", 0.5))
+    tally = {c: [0, 0, 0] for c in cases}
+    wrong = []
+    for name in vm.BEARINGS:
+        for seed in range(n):
+            comb = vm.synth.cage_pulsing(fs=fs, duration=6.0, rpm=rpm, bearing=name, seed=seed)
+            for fault, share in cases:
+                base = vm.synth.machine(fault=fault, rpm=rpm, fs=fs, duration=6.0, snr_db=0, bearing=name, seed=seed)
+                x = base.data[0] + share * np.std(base.data[0]) * comb
+                top = vm.diagnose(vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="g"), rpm=rpm,
+                                  bearing=name).top
+                k = 0 if top == fault else 1 if top == "none" else 2
+                tally[(fault, share)][k] += 1
+                if k == 2:
+                    wrong.append(f"{name} {SHORT[fault]} -> {SHORT.get(top, top)}")
+    print("  " + "   ".join(f"{SHORT[f]} (comb {s:g} x) {'/'.join(map(str, v))}" for (f, s), v in tally.items()))
+    if wrong:
+        print("    wrong: " + "; ".join(wrong))
+
+
 # (faulty bearing, bearing declared): every defect frequency of one differs by more than 3 % from the
 # other's, so a bearing call names a fault the declared bearing does not have
 OTHER_BEARING = [("6205-2RS", "6203-2RS"), ("6203-2RS", "6205-2RS"), ("6205-2RS", "6309"), ("6309", "6205-2RS"),
@@ -292,6 +321,7 @@ def main(n):
     stress(max(5, n // 2))
     run_up(max(5, n // 2))
     rigs(2)
+    cage_combs(2)
     other_bearing(3)
     mains(2)
     cwru()

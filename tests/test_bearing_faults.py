@@ -213,26 +213,14 @@ def test_stress_cases(kw, bearing, ok):
             assert "cage comb" not in d.reason, d.reason
 
 
-def _sharp_cage_comb(n, fs, rpm, bearing, seed, width=1 / 15):
-    """Resonance-band noise whose level pulses once per cage turn (a Gaussian pulse): its envelope is
-    a comb of FTF harmonics falling as exp(-(k width)^2 / 2), 0.83 at the 9th, 0.49 at the 18th, so
-    it carries lines at n_balls x FTF (BPFO) and its multiples as high as their neighbours."""
-    ftf = vm.BEARINGS[bearing].frequencies(rpm / 60)["FTF"]
-    rng = np.random.default_rng(seed)
-    turns = (ftf * np.arange(n) / fs + rng.uniform()) % 1.0 - 0.5
-    pulse = np.exp(-0.5 * (turns * 2 * np.pi / width) ** 2)
-    from scipy.signal import butter, sosfiltfilt
-    noise = sosfiltfilt(butter(4, [2500, 4500], "bandpass", fs=fs, output="sos"), rng.standard_normal(n))
-    x = noise * (1 + 4 * pulse)
-    return x / np.std(x)
-
-
 def _with_cage_comb(fault, bearing, seed, share, snr_db=0):
-    """A synthetic machine (6 s at 20 kHz, 1797 rpm) with ``_sharp_cage_comb`` added at ``share`` x its
-    RMS, diagnosed with its bearing: the diagnosis and its table indexed by fault."""
-    fs, rpm, n = 20000.0, 1797.0, 120000
+    """A synthetic machine (6 s at 20 kHz, 1797 rpm) with a cage comb of many harmonics
+    (``vm.synth.cage_pulsing``) added at ``share`` x its RMS, diagnosed with its bearing: the diagnosis
+    and its table indexed by fault."""
+    fs, rpm = 20000.0, 1797.0
     base = vm.synth.machine(fault=fault, rpm=rpm, fs=fs, duration=6.0, snr_db=snr_db, bearing=bearing, seed=seed)
-    x = base.data[0] + share * np.std(base.data[0]) * _sharp_cage_comb(n, fs, rpm, bearing, seed)
+    comb = vm.synth.cage_pulsing(fs=fs, duration=6.0, rpm=rpm, bearing=bearing, seed=seed)
+    x = base.data[0] + share * np.std(base.data[0]) * comb
     d = vm.diagnose(vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="g"), rpm=rpm, bearing=bearing)
     return d, d.faults.set_index("fault")
 

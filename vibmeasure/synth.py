@@ -15,7 +15,8 @@ from .core.errors import ParameterError
 from .core.record import Channel, Record
 from .models.sdof import coulomb_response  # noqa: F401  (public here too: synth.coulomb_response)
 
-__all__ = ["free_decay", "coulomb_decay", "coulomb_response", "noise_std_for_snr", "machine", "fleet", "ambient", "base_excited"]
+__all__ = ["free_decay", "coulomb_decay", "coulomb_response", "noise_std_for_snr", "machine", "cage_pulsing", "fleet",
+           "ambient", "base_excited"]
 
 _ORDER = {"displacement": 0, "velocity": 1, "acceleration": 2}
 
@@ -403,6 +404,36 @@ def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: f
         x = np.vstack([x, 5.0 * (np.mod(ang * tach, 1.0) < 0.25)])
         channels += (_Ch("tach", "unknown", "V"),)
     return Record(x, fs, channels, meta={"rpm": rpm, "truth": truth}, history=(f"synth machine {fault}",))
+
+
+def cage_pulsing(*, fs: float, duration: float, rpm: float = 1797.0, bearing="6205-2RS", width: float = 1 / 15,
+                 band=(2500.0, 4500.0), seed=None) -> np.ndarray:
+    """Unit-RMS noise in ``band`` (Hz) whose level pulses once per turn of the bearing's cage: the
+    Gaussian pulse exp(-(2 pi t / width)^2 / 2) over the turn's phase t (-0.5..0.5), four times the
+    floor at its peak. Its envelope is a comb of FTF harmonics falling as exp(-(k width)^2 / 2), 0.83 at
+    the 9th and 0.49 at the 18th for the default width: a cage comb of many harmonics, which carries
+    lines where BPFO (n_balls x FTF) and, on most geometries, BPFI or 2 x BSF fall. Added to a machine
+    (``machine``), a stress case for the diagnosis: an uneven cage or load on a healthy bearing."""
+    from .models.bearing import bearing_from
+    from scipy.signal import butter, sosfiltfilt
+    fs, duration, rpm = positive(fs, "fs"), positive(duration, "duration"), positive(rpm, "rpm")
+    if not 0 < width <= 0.5:
+        raise ParameterError(f"width={width!r} must be in (0, 0.5]: the pulse's width, 2 pi x its standard "
+                             "deviation in cage turns")
+    lo, hi = (float(v) for v in band)
+    if not 0 < lo < hi < fs / 2:
+        raise ParameterError(f"band={band!r} must be (low, high) Hz with 0 < low < high < fs/2 = {fs / 2:g}")
+    n = int(round(fs * duration))
+    b = bearing_from(bearing)
+    if b is None:
+        raise ParameterError("bearing is required: a vm.Bearing or a catalogue name (vm.BEARINGS)")
+    ftf = b.frequencies(rpm / 60)["FTF"]
+    rng = np.random.default_rng(seed)
+    turns = (ftf * np.arange(n) / fs + rng.uniform()) % 1.0 - 0.5
+    pulse = np.exp(-0.5 * (turns * 2 * np.pi / width) ** 2)
+    noise = sosfiltfilt(butter(4, [lo, hi], "bandpass", fs=fs, output="sos"), rng.standard_normal(n))
+    x = noise * (1 + 4 * pulse)
+    return x / max(np.std(x), 1e-300)
 
 
 def fleet(folder=None, *, n_measurements: int = 52, start: str = "2026-01-05", interval_days: float = 7.0,
