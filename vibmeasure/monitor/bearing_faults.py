@@ -15,16 +15,18 @@ Pipeline for one record (``bearing_evidence``):
 2. normalise: each SES power line divided by its local floor (running median / ln 2), and mapped
    through the exact law of that median (``_exact_exponential``), so that for Gaussian noise the
    ratio ``r`` is exponential with mean 1 (chi-square with 2 degrees of freedom over 2) even where
-   the floor rests on few bins (short records). Where a channel's cage comb stands out, the lines it
-   shares with BPFO (n_balls x FTF and its multiples) are divided by the comb's level beside them
-   (``_cage_floor``), before the channels are averaged.
+   the floor rests on few bins (short records). Where a channel's cage comb stands out (its
+   fundamental refined on its own lines up to the 24th harmonic), the lines it shares with BPFO
+   (n_balls x FTF and its multiples), and those where BPFI or the ball family's lines fall on its
+   harmonics (``_cage_shared``), are divided by the comb's level beside them (``_cage_floor``), before
+   the channels are averaged.
 3. explain: lines at exact shaft harmonics (those a bearing line could also be only when a spectrum
    shows the shaft at a harmonic no bearing line explains, ``_shaft_shows``), then the cage comb (FTF
-   harmonics that are not BPFO's), are claimed first; then the bearing families (BPFO; BPFI with +-1X
-   sidebands; 2xBSF with +-FTF sidebands, and BSF) are tested; of those that pass, the one with more
-   (and stronger) of its own first three harmonics claims its lines with their sidebands, unless
-   another significant family explains its lines and more (``_explain``); the others are tested again
-   without them. A line is evidence for one family only. An inner-race or ball family is called only
+   harmonics that are not BPFO's nor shared with BPFI or the ball family), are claimed first; then
+   the bearing families (BPFO; BPFI with +-1X sidebands; 2xBSF with +-FTF sidebands, and BSF) are
+   tested; of those that pass, the one with more (and stronger) of its own first three harmonics
+   claims its lines with their sidebands, unless another significant family explains its lines and
+   more (``_explain``); the others are tested again without them. A line is evidence for one family only. An inner-race or ball family is called only
    with its modulation sidebands (+-1X: the defect turns through the load zone; +-FTF: the ball
    travels with the cage) and a line at one of its first three harmonics: a bare comb near BPFI or
    2xBSF is not called. No family is called from lines that stand only at multiples of one of its
@@ -394,11 +396,11 @@ def _cage_floor(ses: _SES, freqs: dict, f1: float, n_balls: int) -> dict | None:
     changes. The median, not the mean, so that one shaft line or one sideband among the neighbours
     does not set it. Where the comb's fundamental is refined on its lines (``_cage_comb``), only the
     line's bins are divided (2 bins plus one per 12 harmonics either side of where the fit puts it);
-    else the whole stretch, since the FTF searched on harmonics 1-6 does not pin the 18th to a bin (and a line of
-    another family inside it is divided too: the 6205's 2 x BPFI lies 0.7 % from its 3 x BPFO). The harmonics an
-    inner-race or ball line shares are weighed the same way, against the nearest harmonics either side
-    that are neither BPFO's nor shared: a healthy bearing's cage comb then gives those families nothing,
-    a defect's line what it stands above the comb.
+    else the whole stretch, since the FTF searched on harmonics 1-6 does not pin the 18th to a bin
+    (and a line of another family inside it is divided too: the 6205's 2 x BPFI lies 0.7 % from its
+    3 x BPFO). The harmonics an inner-race or ball line shares are weighed the same way, against the
+    nearest harmonics either side that are neither BPFO's nor shared: a healthy bearing's cage comb
+    then gives those families nothing, a defect's line what it stands above the comb.
 
     A ball defect rides with the cage into and out of the load zone: the envelope carries the cage
     comb (CWRU drive-end B007_0: 18 of FTF x 1-21 at 5-15 dB), and its 9th and 18th harmonics, the 6205's
