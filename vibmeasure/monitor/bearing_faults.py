@@ -22,19 +22,19 @@ Pipeline for one record (``bearing_evidence``):
    the channels are averaged.
 3. explain: lines at exact shaft harmonics (those a bearing line could also be only when a spectrum
    shows the shaft at a harmonic no bearing line explains, ``_shaft_shows``), then the cage comb (FTF
-   harmonics that are not BPFO's nor shared with BPFI or the ball family), are claimed first; then
-   the bearing families (BPFO; BPFI with +-1X sidebands; 2xBSF with +-FTF sidebands, and BSF) are
-   tested; of those that pass, the one with more (and stronger) of its own first three harmonics
-   claims its lines with their sidebands, unless another significant family explains its lines and
-   more (``_explain``); the others are tested again without them. A line is evidence for one family only. An inner-race or ball family is called only
-   with its modulation sidebands (+-1X: the defect turns through the load zone; +-FTF: the ball
-   travels with the cage) and a line at one of its first three harmonics: a bare comb near BPFI or
-   2xBSF is not called. No family is called from lines that stand only at multiples of one of its
-   harmonics (``_step``): lines at harmonics 2 and 4 alone are a comb at twice its fundamental, a 3rd
-   harmonic with its +-1X sidebands alone one at three times it, and neither is a frequency of this
-   bearing. A family that explains lines best but fails those conditions still claims them (it is not
-   called there): the sidebands k x BPFI - k x 1X of an inner race whose carriers are weak make a comb
-   at 3.947 X, inside the +-2 % of the 6203's 2 x BSF (3.987 X).
+   harmonics that are not BPFO's nor shared with BPFI or the ball family), are claimed first; then the
+   bearing families (BPFO; BPFI with +-1X sidebands; 2xBSF with +-FTF sidebands, and BSF) are tested;
+   of those that pass, the one with more (and stronger) of its own first three harmonics claims its
+   lines with their sidebands, unless another significant family explains its lines and more
+   (``_explain``); the others are tested again without them. A line is evidence for one family only. An
+   inner-race or ball family is called only with its modulation sidebands (+-1X: the defect turns
+   through the load zone; +-FTF: the ball travels with the cage) and a line at one of its first three
+   harmonics: a bare comb near BPFI or 2xBSF is not called. No family is called from lines that stand
+   only at multiples of one of its harmonics (``_step``): lines at harmonics 2 and 4 alone are a comb
+   at twice its fundamental, a 3rd harmonic with its +-1X sidebands alone one at three times it, and
+   neither is a frequency of this bearing. A family that explains lines best but fails those conditions
+   still claims them (it is not called there): the sidebands k x BPFI - k x 1X of an inner race whose
+   carriers are weak make a comb at 3.947 X, inside the +-2 % of the 6203's 2 x BSF (3.987 X).
 4. test: a family's statistic is the sum of r over its comb (harmonics 1-3 and sidebands) at the
    common slip (within +-2 %) that maximises it; under noise that sum is Gamma(n_terms) distributed,
    and the p-value is multiplied by the number of slip positions, bins and sub-models searched
