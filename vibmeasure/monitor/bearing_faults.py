@@ -476,7 +476,7 @@ def _refined(ses: _SES, f0: float, ks) -> float | None:
 
     The slip searched on harmonics 1-6 pins the fundamental to half a bin over the 6th harmonic at
     best, and worse where their lines are so strong that every one is capped (R_CAP) over a range of
-    slips: a healthy 6203 whose envelope pulses once per cage turn showed its 13th-27th harmonics 3-5
+    slips: a healthy 6203 whose envelope pulses once per cage turn showed its 13th-27th harmonics 2-5
     bins from where that fit put them; the comb's level beside BPFO x 2-3 (``_cage_floor``) was then
     read off its lines, below the noise floor, and BPFO x 1-3 at its 8th, 16th and 24th harmonics was
     called outer race."""
