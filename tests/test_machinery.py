@@ -204,6 +204,30 @@ def test_plot_diagnosis_shows_ses_comb_and_kurtogram(shared_data, tmp_path):
     assert (tmp_path / "d.png").stat().st_size > 10_000
 
 
+def test_plot_diagnosis_marks_the_cage_comb_and_where_its_level_was_divided_out(shared_data):
+    # CWRU fan-end B014_1 (a ball record read "none"): its fused envelope carries the cage comb
+    # (p = 5e-61). The plot ticks the comb's harmonics along the top and marks each stretch where its
+    # level was the floor of another family's lines (BPFO's multiples of 8 x FTF, and the harmonics the
+    # 6203's BPFI and ball lines share); the diagnosis carries them for it
+    import matplotlib
+    matplotlib.use("Agg")
+    from vibmeasure.plot import plot_diagnosis
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rec = vm.read(shared_data("cwru_fe/B014_1.mat"), fs=12000, unit="g")
+    d = vm.diagnose(rec, bearing="6203-2RS")
+    ses = d.extras["ses"]
+    ftf = d.faults.set_index("fault").loc["bearing_cage", "expected_hz"]
+    assert abs(ses["cage_hz"] / ftf - 1) < 0.02          # the comb's fundamental, within the slip
+    assert ses["cage_floor"] and all(lo < hi and level > 1 for lo, hi, level in ses["cage_floor"])
+    eighths = [round((lo + hi) / 2 / ses["cage_hz"]) for lo, hi, _ in ses["cage_floor"]]
+    assert 8 in eighths and 13 in eighths                 # BPFO's first harmonic and BPFI's (shared)
+    ax_e = plot_diagnosis(rec, d)[0]
+    labels = ax_e.get_legend_handles_labels()[1]
+    assert "cage comb (FTF x k)" in labels and "cage comb's level divided out there" in labels
+    shown = [ln for ln in ax_e.lines if ln.get_label() == "cage comb's level divided out there"][0]
+    assert len(shown.get_xdata()) == sum(lo <= ax_e.get_xlim()[1] for lo, _, _ in ses["cage_floor"])
+
+
 def test_without_a_unit_level_gated_faults_are_named_but_not_called(tmp_path, shared_data):
     # a looseness machine whose samples come without a unit: the ISO level cannot be computed, so the
     # looseness pattern is named as the strongest one but not called, and the "none" says little; with

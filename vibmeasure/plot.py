@@ -428,7 +428,8 @@ def plot_diagnosis(rec, diag, *, axes=None):
 
 def _plot_ses(ax, ses, diag, colors):
     """SES in dB over its median floor, the winning comb (solid), its sidebands (dotted) and the other
-    families' expected first harmonics (thin)."""
+    families' expected first harmonics (thin); where the cage comb stands, its harmonics (ticks along
+    the top) and the stretches where its level was divided out (shaded, ``bearing_faults._cage_floor``)."""
     freq, amp = np.asarray(ses["freq"]), np.asarray(ses["amp"])
     tab = diag.faults.set_index("fault")
     fam = ses["family"]
@@ -450,6 +451,22 @@ def _plot_ses(ax, ses, diag, colors):
             ax.text(r.expected_hz, 0.03 + 0.3 * (n_lab % 3), f" {other.split('_', 1)[1]}",
                     transform=ax.get_xaxis_transform(), rotation=90, fontsize=6, color=colors.get(other, "0.5"))
             n_lab += 1
+    # the cage comb where it stands: its harmonics ticked along the top, and the stretches where its
+    # level was the floor of another family's lines (they count only by what they stand above it)
+    cage = ses.get("cage_hz")
+    if cage:
+        ks = np.arange(1, int(fmax / cage) + 1)
+        ax.plot(ks * cage, np.full(ks.size, 0.97), "|", color=colors["bearing_cage"], ms=6,
+                transform=ax.get_xaxis_transform(), label="cage comb (FTF x k)")
+    spans = [(lo, hi) for lo, hi, _ in ses.get("cage_floor", ()) if lo <= fmax]
+    for lo, hi in spans:   # a few bins wide: marked at the top too, where they can be seen
+        ax.axvspan(lo, hi, color=colors["bearing_cage"], alpha=0.3, lw=0)
+    if spans:
+        mid = np.array([(lo + hi) / 2 for lo, hi in spans])
+        ax.plot(mid, np.full(mid.size, 0.91), "v", color=colors["bearing_cage"], ms=4, mfc="none",
+                transform=ax.get_xaxis_transform(), label="cage comb's level divided out there")
+    if cage or ses.get("cage_floor"):
+        ax.legend(loc="upper right", fontsize=7)
     slip = ses.get("slip")
     p = tab.loc[fam, "p_value"]
     f1 = (diag.speed.get("estimated_rpm") or diag.speed["declared_rpm"]) / 60

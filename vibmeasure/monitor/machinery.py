@@ -18,7 +18,7 @@ from ..core import units as _units
 from ..core._validate import as_record, clean_signal, memory_guard, positive, response_channel
 from ..core.errors import ParameterError, warn_quality
 from ..models.bearing import Bearing, Gear, bearing_from
-from .bearing_faults import FAMILIES, bearing_evidence
+from .bearing_faults import FAMILIES, _cage_stands, bearing_evidence
 from .calibration import NONE_BEARING, NONE_SHAFT, UNCHECKED, calibrated
 
 __all__ = ["diagnose", "Diagnosis", "ISO_10816_3", "severity_zone"]
@@ -1220,7 +1220,12 @@ def _plot_material(ev, top):
             break
     kg = next((sp.kurtogram for sp in ev["spectra"] if sp.channel in pick.channel.split("+")
                and sp.kurtogram is not None), None)
+    cage = pick.results.get("bearing_cage")
     ses = {"freq": pick.freq, "amp": pick.amp, "channel": pick.channel, "preprocessing": pick.prep,
-           "band_hz": pick.band, "family": name, "slip": s["slip"], "lines": s["lines"]}
+           "band_hz": pick.band, "family": name, "slip": s["slip"], "lines": s["lines"],
+           # where the cage comb stands: its fundamental, and the stretches its level was divided from
+           "cage_hz": ev["families"]["bearing_cage"]["expected_hz"] * (1 + cage["slip"])
+           if cage is not None and _cage_stands(cage) else None,
+           "cage_floor": sorted(pick.cage_floor.values())}
     return {"bearing": {k: {kk: vv for kk, vv in v.items() if kk != "lines"} for k, v in fams.items()},
             "ses": ses, "kurtogram": kg}
