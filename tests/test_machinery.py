@@ -226,6 +226,17 @@ def test_plot_diagnosis_marks_the_cage_comb_and_where_its_level_was_divided_out(
     assert "cage comb (FTF x k)" in labels and "cage comb's level divided out there" in labels
     shown = [ln for ln in ax_e.lines if ln.get_label() == "cage comb's level divided out there"][0]
     assert len(shown.get_xdata()) == sum(lo <= ax_e.get_xlim()[1] for lo, _, _ in ses["cage_floor"])
+    # a title that names three channels fused, each in its own band (OR014@6_0): wrapped, it stays
+    # clear of the severity gauge's title beside it (it ran into it)
+    rec = vm.read(shared_data("cwru_fe/OR014@6_0.mat"), fs=12000, unit="g")
+    ax_e = plot_diagnosis(rec, vm.diagnose(rec, bearing="6203-2RS"))[0]
+    assert "each in its own band" in ax_e.get_title(loc="left")
+    fig = ax_e.figure
+    fig.canvas.draw()
+    gauge = next(a for a in fig.axes if "ISO 10816-3" in a.get_title())
+    assert ax_e.get_title(loc="left") and not ax_e.get_title()   # the title is the left one
+    right = ax_e._left_title.get_window_extent().x1
+    assert right < gauge.title.get_window_extent().x0
 
 
 def test_without_a_unit_level_gated_faults_are_named_but_not_called(tmp_path, shared_data):

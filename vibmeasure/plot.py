@@ -472,10 +472,15 @@ def _plot_ses(ax, ses, diag, colors):
     f1 = (diag.speed.get("estimated_rpm") or diag.speed["declared_rpm"]) / 60
     for k in range(1, int(fmax / f1) + 1):
         ax.axvline(k * f1, color="C0", lw=0.4, ls=(0, (1, 3)), alpha=0.5)
-    ax.set_title(f"squared-envelope spectrum ({ses['preprocessing']}, {ses['band_hz'][0]:.0f}-{ses['band_hz'][1]:.0f} Hz, "
-                 f"{ses['channel']}); top = {diag.top}\n{fam.split('_', 1)[1]} comb (solid, sidebands dotted) at "
+    import textwrap
+    head = (f"squared-envelope spectrum ({ses['preprocessing']}, {ses['band_hz'][0]:.0f}-{ses['band_hz'][1]:.0f} Hz, "
+            f"{ses['channel']}); top = {diag.top}")
+    # wrapped to the axes' width: a long channel list ran into the severity gauge's title beside it
+    width = max(40, int(ax.get_position().width * ax.figure.get_figwidth() * 72 / 4.6))
+    ax.set_title("\n".join(textwrap.wrap(head, width) + [
+                 f"{fam.split('_', 1)[1]} comb (solid, sidebands dotted) at "
                  f"{f0:.2f} Hz x (1 {(slip if np.isfinite(slip) else 0) * 100:+.2f} % slip), p = {p:.2g}; "
-                 "shaft orders faint blue", fontsize=8, loc="left")
+                 "shaft orders faint blue"]), fontsize=8, loc="left")
     ax.set_ylabel("SES [dB over floor]")
     ax.set_xlabel("frequency [Hz]")
     ax.set_xlim(0, fmax)
