@@ -417,10 +417,17 @@ def cage_pulsing(*, fs: float, duration: float, rpm: float = 1797.0, bearing="62
     from .models.bearing import bearing_from
     from scipy.signal import butter, sosfiltfilt
     fs, duration, rpm = positive(fs, "fs"), positive(duration, "duration"), positive(rpm, "rpm")
+    try:
+        width = float(width)
+    except (TypeError, ValueError):
+        width = np.nan
     if not 0 < width <= 0.5:
         raise ParameterError(f"width={width!r} must be in (0, 0.5]: the pulse's width, 2 pi x its standard "
                              "deviation in cage turns")
-    lo, hi = (float(v) for v in band)
+    try:
+        lo, hi = (float(v) for v in band)
+    except (TypeError, ValueError):
+        lo = hi = np.nan
     if not 0 < lo < hi < fs / 2:
         raise ParameterError(f"band={band!r} must be (low, high) Hz with 0 < low < high < fs/2 = {fs / 2:g}")
     n = int(round(fs * duration))
@@ -428,6 +435,9 @@ def cage_pulsing(*, fs: float, duration: float, rpm: float = 1797.0, bearing="62
     if b is None:
         raise ParameterError("bearing is required: a vm.Bearing or a catalogue name (vm.BEARINGS)")
     ftf = b.frequencies(rpm / 60)["FTF"]
+    if duration * ftf < 1 or n < 256:
+        raise ParameterError(f"duration={duration!r} s must hold at least one turn of the cage ({1 / ftf:.3g} s at "
+                             f"{rpm:g} rpm) and 256 samples")
     rng = np.random.default_rng(seed)
     turns = (ftf * np.arange(n) / fs + rng.uniform()) % 1.0 - 0.5
     pulse = np.exp(-0.5 * (turns * 2 * np.pi / width) ** 2)
