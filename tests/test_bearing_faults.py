@@ -269,7 +269,7 @@ def test_cage_comb_shares_the_harmonics_where_bpfi_or_ball_lines_fall():
 def test_a_comb_fundamental_is_refined_on_its_standing_harmonics():
     # lines at k x 11.4342 Hz, k = 1..24, on a flat floor; the coarse guess 0.2 % low puts the 24th
     # 5.5 bins off. The least-squares fit of the interpolated peaks gives the fundamental back to 1e-4
-    # (a bin is 0.1 Hz: 0.004 bin at the 24th harmonic); with fewer than four lines standing, None
+    # (a bin is 0.1 Hz: 0.004 bin at the 24th harmonic), stage by stage; with no line standing, None
     df, f_true = 0.1, 11.4342
     r = np.ones(6000)
     for k in range(1, 25):
@@ -284,12 +284,12 @@ def test_a_comb_fundamental_is_refined_on_its_standing_harmonics():
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_bpfi_carriers_on_cage_harmonics_stay_with_the_inner_race(seed):
-    # the 6203's BPFI x 1-3 fall on the cage comb's 13th, 26th and 39th harmonics (0.3 %). The comb
-    # claimed them when it stood: under a comb as loud as the machine a healthy 6203 was called outer
-    # race (seeds 0, 1), and an inner-race fault lost its carriers (BPFI x 1 claimed: -120 dB). Now the
-    # comb leaves them to the inner race and is their floor there (_cage_floor): healthy reads "none"
-    # with no inner-race comb (p = 1 measured); the fault keeps its carriers (BPFI x 1 at 14-16 dB) and is
-    # called
+    # the 6203's BPFI x 1-3 fall on the cage comb's 13th, 26th and 39th harmonics (0.3 %). Under a comb
+    # as loud as the machine, before, the comb claimed them (an inner-race fault's BPFI x 1 at -120 dB),
+    # and a healthy 6203 was called outer race (seeds 0, 1: the comb's level beside BPFO was read off
+    # its lines, its fundamental unrefined). Now the comb leaves them to the inner race and is their
+    # floor there (_cage_floor): healthy reads "none" with no inner-race comb (p = 1 measured); the
+    # fault keeps its carriers (BPFI x 1 at 14-16 dB) and is called
     d, rows = _with_cage_comb("none", "6203-2RS", seed, 1.0)
     assert d.top == "none", d.reason
     assert rows.loc["bearing_inner_race"].p_value > 0.01 and rows.loc["bearing_outer_race"].p_value > 0.01
