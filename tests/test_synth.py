@@ -171,7 +171,8 @@ def test_cage_pulsing_follows_its_pulse_over_the_cage_turn():
     (dict(width=0.0), "width"), (dict(width=0.8), "width"), (dict(width="wide"), "width"),
     (dict(band=(2500.0, 12000.0)), "band"),
     (dict(band=(1.0, 2.0, 3.0)), "band"), (dict(band="low"), "band"), (dict(bearing=None), "bearing"),
-    (dict(fs=-1.0), "fs"), (dict(duration=0.0), "duration"), (dict(duration=0.05), "turn of the cage")])
+    (dict(fs=-1.0), "fs"), (dict(duration=0.0), "duration"), (dict(duration=0.05), "turn of the cage"),
+    (dict(duration=1e9), "memory"), (dict(seed="x"), "seed"), (dict(seed=-1), "seed")])
 def test_cage_pulsing_bad_input(kw, msg):
     args = dict(fs=20000.0, duration=1.0, rpm=1797.0, bearing="6205-2RS", seed=0) | kw
     with pytest.raises(vm.ParameterError, match=msg):

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from .core import units as _units
-from .core._validate import positive
+from .core._validate import check_memory, positive
 from .core.errors import ParameterError
 from .core.record import Channel, Record
 from .models.sdof import coulomb_response  # noqa: F401  (public here too: synth.coulomb_response)
@@ -438,7 +438,11 @@ def cage_pulsing(*, fs: float, duration: float, rpm: float = 1797.0, bearing="62
     if duration * ftf < 1 or n < 256:
         raise ParameterError(f"duration={duration!r} s must hold at least one turn of the cage ({1 / ftf:.3g} s at "
                              f"{rpm:g} rpm) and 256 samples")
-    rng = np.random.default_rng(seed)
+    check_memory(64.0 * n, "cage_pulsing", n)   # about eight float arrays of the record's length
+    try:
+        rng = np.random.default_rng(seed)
+    except (TypeError, ValueError):
+        raise ParameterError(f"seed={seed!r} must be None or a non-negative integer") from None
     turns = (ftf * np.arange(n) / fs + rng.uniform()) % 1.0 - 0.5
     pulse = np.exp(-0.5 * (turns * 2 * np.pi / width) ** 2)
     noise = sosfiltfilt(butter(4, [lo, hi], "bandpass", fs=fs, output="sos"), rng.standard_normal(n))
