@@ -8,8 +8,9 @@ mix it was learnt on: with SNRs -10 to 10 dB in steps of 5 (tried), unbalance ca
 buried resonance looks like unbalance, came out over-confident on the benchmark.
 
 Each machine is diagnosed with its bearing named and again without it (the maps of a diagnosis that
-could not check bearing faults). N = 150 gives 8,100 diagnoses in about 2 minutes on 2 cores and
-reproduces the shipped table exactly (every seed is fixed).
+could not check bearing faults); the machines at EDGE_SNRS (-15 dB) only with it, and only for the
+bearing part of a "none" (NONE_BEARING, see EDGE_SNRS below). N = 150 gives 9,450 diagnoses in about
+5 minutes on 2 cores and reproduces the shipped table exactly (every seed is fixed).
 
     python benchmarks/calibrate_diagnosis.py [N]      (N seeds per machine kind and SNR; default 150)
 """
@@ -29,6 +30,14 @@ from vibmeasure.monitor.machinery import SHAFT_FAULTS
 FAULTS = ["none", "unbalance", "misalignment", "looseness", "bearing_outer_race", "bearing_inner_race",
           "bearing_ball", "gear_mesh", "resonance"]
 SNRS = [-10, 0, 10]
+# the "none" map of the bearing side (NONE_BEARING) is also learnt at the edge of bearing-fault detection:
+# at -10 dB and above the synthetic bearing faults are found nearly always, so the benchmark's SNRs hold
+# no "none" left beside a bearing family's near miss (p 1e-4 to 0.05), the case real recordings bring
+# (the CWRU fan-end ball records: "none" at 0.99 beside a ball comb at p = 0.0011 and 0.0016). At -15 dB
+# 71 % of them are found (60 seeds a kind, measured), and a "none" whose bearing part is below 0.95 was
+# left beside a bearing fault in 41 of 41 cases. Machines at these SNRs teach that map only: the others
+# (fault calls, NONE_SHAFT) stay learnt on the benchmark's mix, which the reliability table checks.
+EDGE_SNRS = [-15]
 DURATIONS = [6.0]
 MIN_ANSWERS = 50
 
@@ -37,26 +46,33 @@ def one(job):
     """(answer, group, score, right) with the bearing given, and again without it (keys prefixed
     UNCHECKED: bearing faults not checked, so a bearing-fault machine's "none" is wrong)."""
     fault, snr, duration, seed = job
+    edge = snr in EDGE_SNRS   # teaches the NONE_BEARING map only
     warnings.simplefilter("ignore", vm.QualityWarning)
     machinery.calibrated = lambda answer, score, group: score  # raw scores only: the map is being made
     rec = vm.synth.machine(fault=fault, snr_db=snr, seed=1000 * (snr + 100) + 500 + seed, duration=duration)
     out = []
     for prefix, kw in (("", dict(bearing="6205-2RS")), (UNCHECKED, {})):
+        if edge and prefix:
+            continue
         d = vm.diagnose(rec, gear=32, **kw)
-        out.append((prefix + d.top, prefix + d.extras["confidence_kind"], d.extras["score"], d.top == fault))
+        if not edge:
+            out.append((prefix + d.top, prefix + d.extras["confidence_kind"], d.extras["score"], d.top == fault))
         if not prefix and d.top == "none":   # the two parts of a "none", each against its kind of fault
             parts = d.extras["score_parts"]
-            out.append((NONE_SHAFT, NONE_SHAFT, parts["shaft"], fault not in SHAFT_FAULTS))
+            if not edge:
+                out.append((NONE_SHAFT, NONE_SHAFT, parts["shaft"], fault not in SHAFT_FAULTS))
             out.append((NONE_BEARING, NONE_BEARING, parts["bearing"], fault not in FAMILIES))
     return out
 
 
 def main(n):
-    jobs = [(f, s, dur, k) for f in FAULTS for s in SNRS for dur in DURATIONS for k in range(n)]
+    jobs = [(f, s, dur, k) for f in FAULTS for s in SNRS + EDGE_SNRS for dur in DURATIONS for k in range(n)]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(2) as pool:
         out = [a for answers in pool.map(one, jobs, chunksize=8) for a in answers]
-    print(f"{2 * len(jobs)} diagnoses (with and without the bearing) in {time.perf_counter() - t0:.0f} s")
+    n_edge = sum(j[1] in EDGE_SNRS for j in jobs)
+    print(f"{2 * (len(jobs) - n_edge) + n_edge} diagnoses (with and without the bearing; the edge SNRs' with it "
+          f"only) in {time.perf_counter() - t0:.0f} s")
     rows = []
     # one map per answer given at least MIN_ANSWERS times, and one per group for the rarer answers
     answers = sorted({a for a, *_ in out}, key=lambda a: (a.startswith(UNCHECKED), a.split(":")[-1] != "none", a))
