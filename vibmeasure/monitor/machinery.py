@@ -1023,7 +1023,8 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     """Diagnose a rotating machine from an acceleration record.
 
     ``rpm`` is the declared shaft speed (default: the record's meta["rpm"]); ``bearing`` a vm.Bearing
-    or a catalogue name (``vm.BEARINGS``: "6205-2RS", "6203", "NU205", ...); ``gear`` a tooth count
+    or a catalogue name (``vm.BEARINGS``: "6205-2RS", "6203", "6308-2Z C3", "MFPT", ...; a roller
+    bearing, which the catalogue does not hold, as vm.Bearing from the maker's data); ``gear`` a tooth count
     or vm.Gear; ``machine_group`` (1 or 2) and ``foundation`` ("rigid", "flexible") select the ISO
     10816-3 zones (default group 2, rigid). ``channel`` is the channel for speed, severity and shaft
     orders (default the first that is not a force); bearing faults are searched in every channel
