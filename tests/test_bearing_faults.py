@@ -408,13 +408,14 @@ def development_set():
 
 
 def test_development_set_scores(development_set):
-    # measured: 39 right, 14 none, 0 wrong of 53 (benchmarks/diagnosis_real.py; 13 none and 1 wrong, B021_3,
-    # before a call needed two views of the record or overwhelming evidence in one, MIN_VOTES);
-    # the test guards the floor the issue sets for wrong calls and every inner race, and the level reached
+    # measured: 42 right, 11 none, 0 wrong of 53 (benchmarks/diagnosis_real.py; 39 right before the ball's
+    # smeared comb, 13 none and 1 wrong, B021_3, before a call needed two views of the record or
+    # overwhelming evidence in one, MIN_VOTES); the test guards the issue's targets (>= 40 right, <= 2
+    # wrong), every inner race, and the level reached
     right = sum(d.top == t for t, d in development_set.values())
     wrong = sum(d.top != t and d.top != "none" for t, d in development_set.values())
     assert len(development_set) == 53
-    assert wrong <= 1 and right >= 39
+    assert wrong <= 1 and right >= 42
     assert all(d.top == t for t, d in development_set.values() if t == "bearing_inner_race")
 
 
@@ -471,11 +472,12 @@ def test_overwhelming_evidence_in_one_view_is_called():
 
 
 def test_a_none_names_why_its_strongest_candidate_was_not_called(development_set):
-    # B007_2 (fan-end ball fault, channel FE): a 2xBSF comb at p ~ 0.01 (0.002 before the floor ratio was
-    # mapped to the exact law of the median), above ALPHA, with only one of its lines 7.8 dB above the
-    # floor and no +-FTF sideband: the rule (p, two lines, the cage modulation of a ball defect) keeps it
-    # from a call, and the answer says which parts failed
-    truth, d = development_set["B007_2.mat"]
+    # B021_0 (fan-end ball fault, channel FE): a 2xBSF comb at p = 0.0011, above ALPHA, with only one of
+    # its lines 7.8 dB above the floor and no +-FTF sideband (and no smeared comb: its humps stand at
+    # p = 0.08 uncorrected): the rule (p, two lines, the cage modulation of a ball defect) keeps it from
+    # a call, and the answer says which parts failed. (B007_2, this test's record before, is now called
+    # ball from its smeared comb.)
+    truth, d = development_set["B021_0.mat"]
     ball = d.faults.set_index("fault").loc["bearing_ball"]
     assert truth == "bearing_ball" and d.top == "none"
     assert 1e-3 <= ball.p_value < 0.05
@@ -569,3 +571,116 @@ def test_a_strong_tone_does_not_make_a_bearing_call(shared_data, monkeypatch):
         assert "one view of the record only" in d.faults.set_index("fault").loc["bearing_inner_race"].not_called
         monkeypatch.setattr(bf, "MIN_VOTES", 1)
         assert vm.diagnose(noisy, **kw).top == "bearing_inner_race"
+
+
+# --- the ball's smeared comb ----------------------------------------------------------------------
+
+def test_hann_var_is_the_variance_of_a_sum_of_hann_windowed_periodogram_bins():
+    # oracle: white noise, Hann window, periodogram over its mean: the sum over M = 200 neighbouring bins
+    # has variance M x HANN_VAR (1 + 2 (rho1 + rho2), rho the power correlation of bins 1 and 2 apart:
+    # (0.25/0.375)^2 and (0.0625/0.375)^2). 400 records: the variance estimate's std is about 7 %;
+    # tolerance 20 %
+    rng = np.random.default_rng(5)
+    n, M = 8192, 200
+    w = np.hanning(n)
+    sums = []
+    for _ in range(400):
+        P = np.abs(np.fft.rfft(rng.normal(size=n) * w)) ** 2
+        P /= P[100:-100].mean()
+        sums.append(P[1000:1000 + M].sum())
+    assert np.var(sums) / M == pytest.approx(bf.HANN_VAR, rel=0.2)
+    assert bf.HANN_VAR == pytest.approx(1 + 2 * (4 / 9 + 1 / 36))
+
+
+def _hump_ses(centres, rel=0.015, gain=3.0, seed=0, df=0.1, n=10000):
+    """A hand-built SES: exponential noise (power over a flat floor) with humps of gain x the floor over
+    +-rel of each centre."""
+    rng = np.random.default_rng(seed)
+    f = np.arange(n) * df
+    P = rng.exponential(size=n)
+    for c in centres:
+        P[np.abs(f - c) <= rel * c] *= gain
+    return bf._SES("acc", "cepstral", (1000.0, 6000.0), f, np.sqrt(P), P, n)
+
+
+def test_a_comb_of_humps_at_2xbsf_is_found_and_the_races_sidebands_are_left_out():
+    # the 6203 at 29.95 Hz: 2 x BSF = 119.4 Hz; BPFO + 1X (121.4 Hz) and BPFI - 1X (118.2 Hz) lie 1.6 % and
+    # 1.0 % from it, and the 1 % left out around them takes half of each hump's bins. Humps of 4 x the
+    # floor (6 dB, as B014_1's first) over +-1.5 % at 2 x BSF x 1-3: below 1e-8 against Gamma(M / HANN_VAR)
+    # (measured 1e-9 to 1e-22 over the seeds); a race's lines at its sidebands (k BPFO + 1X and
+    # k BPFI - 1X, k = 1-3; sharp, +-0.5 %, 30 x the floor) are left out whole and read as the flat floor
+    # does: p > 1e-3 (measured 0.04-0.6 on each of 5 seeds; 9 slips searched)
+    b = vm.BEARINGS["6203-2RS"]
+    fr = b.frequencies(F1)
+    races = [k * fr["BPFO"] + F1 for k in (1, 2, 3)] + [k * fr["BPFI"] - F1 for k in (1, 2, 3)]
+    for seed in range(5):
+        for centres, rel, gain, found in (([k * fr["2xBSF"] for k in (1, 2, 3)], 0.015, 4.0, True),
+                                          (races, 0.005, 30.0, False), ([], 0.015, 3.0, False)):
+            ses = _hump_ses(centres, rel=rel, gain=gain, seed=seed)
+            r, keep = bf._wide_ratio(ses, fr, F1)
+            logp, slip, bands = bf._smear_comb(r, keep, 0.1, fr["2xBSF"], 1.0)
+            if found:
+                assert logp < np.log(1e-8) and abs(slip) <= 0.005 and len(bands) == 3, seed
+            else:
+                assert logp > np.log(1e-3), (seed, centres)
+
+
+def _wandering_ball(seed, wander, level, fs=12000.0, duration=6.0, rpm=1797.0):
+    """A ball defect whose spin wanders: impacts at 2 x BSF x (1 + wander x u(t)), u a smooth random
+    process (below 3 Hz, unit std), amplitude-modulated at the cage rate (load zone), each ringing a
+    3.5 kHz mode (zeta 0.03); level x unit RMS over unit white noise; a small 1X."""
+    from scipy.signal import butter, sosfiltfilt
+    rng = np.random.default_rng(seed)
+    n = int(fs * duration)
+    t = np.arange(n) / fs
+    fr = B6205.frequencies(rpm / 60)
+    u = sosfiltfilt(butter(2, 3.0, fs=fs, output="sos"), rng.normal(size=n))
+    phase = np.cumsum(fr["2xBSF"] * (1 + wander * u / u.std())) / fs
+    k = np.flatnonzero(np.diff(np.floor(phase)) > 0)
+    x = np.zeros(n)
+    x[k] = 0.5 * (1 + np.cos(2 * np.pi * fr["FTF"] * t[k])) * (1 + 0.1 * rng.normal(size=k.size))
+    tt = np.arange(int(0.01 * fs)) / fs
+    y = np.convolve(x, np.exp(-2 * np.pi * 3500 * 0.03 * tt) * np.sin(2 * np.pi * 3500 * tt))[:n]
+    y = level * y / max(y.std(), 1e-300) + rng.normal(size=n) + 0.05 * np.sin(2 * np.pi * rpm / 60 * t)
+    return vm.Record.from_array(y[None, :], fs=fs, names=["acc"], unit="g")
+
+
+def test_a_ball_whose_spin_wanders_is_called_from_its_smeared_comb():
+    # spin wandering by 3 % (std): the 2 x BSF lines spread over about 8 Hz and no line comb passes; the
+    # humps do (one channel: the record's only view). The same record without the defect: "none", and
+    # its smeared comb nowhere near
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    d = vm.diagnose(_wandering_ball(2, 0.03, 0.3), rpm=1797, bearing="6205-2RS")
+    row = d.faults.set_index("fault").loc["bearing_ball"]
+    assert d.top == "bearing_ball" and d.confidence > 0.5
+    assert "smeared" in row.note and "no line comb passes" in row.note and row.p_value < 1e-6
+    assert d.extras["bearing"]["bearing_ball"]["smeared"]["found"]
+    h = vm.diagnose(_wandering_ball(2, 0.03, 0.0), rpm=1797, bearing="6205-2RS")
+    assert h.top == "none"
+    sm = h.extras["bearing"]["bearing_ball"].get("smeared")
+    assert sm is None or (not sm["found"] and sm["log_p"] > np.log(1e-3))
+
+
+@pytest.mark.parametrize("name", ["B007_1.mat", "B007_2.mat", "B014_1.mat"])
+def test_fan_end_ball_records_rest_on_a_smeared_comb(development_set, name):
+    # no ball line comb passes on these (p 0.01-0.1, a line or none at 7.8 dB, no +-FTF sidebands); with
+    # the races' lines left out, humps at 2 x BSF x 1-3 stand at p 1e-19 to 1e-23 (corrected), the best
+    # of 16-19 decoy combs at 1e-4 or more
+    truth, d = development_set[name]
+    row = d.faults.set_index("fault").loc["bearing_ball"]
+    sm = d.extras["bearing"]["bearing_ball"]["smeared"]
+    assert d.top == truth == "bearing_ball"
+    assert "smeared" in row.note and row.p_value < 1e-10
+    assert sm["log_p"] <= sm["decoy_log_p"] - bf.SMEAR_MARGIN * np.log(10)
+    assert abs(row.found_hz / row.expected_hz - 1) <= bf.SLIP + 1e-9
+
+
+def test_a_smeared_comb_of_the_other_bearing_is_held_to_its_decoys(shared_data):
+    # fan-end B007_3 read with the drive end's 6205 declared: humps at the 6205's 2 x BSF x 1-3 (136, 272,
+    # 408 Hz, +2.5 to +3 dB, p = 2.8e-9) in a spectrum whose decoy combs reach 1e-5. With 7 decoys (2 %
+    # steps) it passed the margin and was called ball, on a bearing with no seeded fault; with decoys in
+    # 0.5 % steps (16 here) their best is strict enough: no call
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    d = vm.diagnose(vm.read(shared_data("cwru_fe/B007_3.mat"), fs=12000, unit="g"), bearing="6205-2RS")
+    assert d.top == "none"
+    assert 15 <= bf._smear_decoys(B6205.frequencies(1730 / 60), 1730 / 60).size <= 25

@@ -438,9 +438,15 @@ def _plot_ses(ax, ses, diag, colors):
     sel = (freq > 0) & (freq <= fmax)
     floor = np.median(amp[sel] ** 2)
     ax.plot(freq[sel], 10 * np.log10(np.maximum(amp[sel] ** 2, 1e-300) / floor), lw=0.6, color="0.35")
+    # a ball called from its smeared comb (bearing_faults._smeared_ball): each hump's band shaded
+    smeared = "smeared" in str(tab.loc[fam, "note"])
     for ln in ses["lines"]:
         style = "-" if ln["sideband"] == 0 else ":"
         ax.axvline(ln["hz"], color=colors.get(fam, "C3"), lw=0.9, ls=style, alpha=0.8)
+        if smeared:
+            from .monitor.bearing_faults import SMEAR_WIDTH
+            ax.axvspan(ln["hz"] * (1 - SMEAR_WIDTH), ln["hz"] * (1 + SMEAR_WIDTH), color=colors.get(fam, "C3"),
+                       alpha=0.15, lw=0)
         if ln["db"] >= 7.8:
             ax.plot(ln["hz"], ln["db"], "v", color=colors.get(fam, "C3"), ms=5)
     n_lab = 0
@@ -478,7 +484,7 @@ def _plot_ses(ax, ses, diag, colors):
     # wrapped to the axes' width: a long channel list ran into the severity gauge's title beside it
     width = max(40, int(ax.get_position().width * ax.figure.get_figwidth() * 72 / 4.6))
     ax.set_title("\n".join(textwrap.wrap(head, width) + [
-                 f"{fam.split('_', 1)[1]} comb (solid, sidebands dotted) at "
+                 f"{fam.split('_', 1)[1]} comb ({'smeared: humps shaded' if smeared else 'solid, sidebands dotted'}) at "
                  f"{f0:.2f} Hz x (1 {(slip if np.isfinite(slip) else 0) * 100:+.2f} % slip), p = {p:.2g}; "
                  "shaft orders faint blue"]), fontsize=8, loc="left")
     ax.set_ylabel("SES [dB over floor]")

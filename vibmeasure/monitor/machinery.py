@@ -875,12 +875,21 @@ def _bearing_rows(job: _Job, f1: float, speed: dict):
         {job.fs / f["spike_interval_samples"] for f in job.quality.values() if "spike_interval_samples" in f}))
     ev = bearing_evidence(job.signals, job.fs, f1, freqs, job.bearing.n_balls, band=job.band,
                           shaft_hz=shaft, f1_known=speed["estimated_rpm"] is not None, whitening=job.prewhitening,
-                          artefact_hz=glitch, speed_search=SPEED_SEARCH, speed_confirmed=_confirmed(speed))
+                          artefact_hz=glitch, speed_search=SPEED_SEARCH, speed_confirmed=_confirmed(speed),
+                          smeared_ball=not ("speed_varies" in job.flags and "order_tracked" not in job.flags))
     rows = []
     for name, s in ev["families"].items():
         lines = [f"{ln['hz']:.1f} Hz {ln['db']:.0f} dB" for ln in s["lines"] if ln["r"] >= 6.0]
+        sm = s.get("smeared")
         if name == "bearing_cage":
             note = CAGE_NOTE if s["found"] else "no cage-rate comb"
+        elif sm is not None and sm["found"]:
+            humps = ", ".join(f"{ln['hz']:.1f} Hz {ln['db']:+.1f} dB" for ln in s["lines"])
+            note = (f"{s['model']} at slip {s['slip'] * 100:+.2f} %: no line comb passes, but humps stand at 2 x BSF "
+                    f"and its harmonics ({humps}: mean over each hump's bins, the races' lines left out): a ball's "
+                    f"spin wanders and spreads its lines; p = {s['p_value']:.2g}, best decoy comb p = "
+                    f"{np.exp(sm['decoy_log_p']):.2g}; in {sm['views']} views; {s['preprocessing']} "
+                    f"{s['band_hz'][0]:.0f}-{s['band_hz'][1]:.0f} Hz in {s['channel']!r}")
         elif s["p_value"] < 1.0:
             note = (f"{s['model']} at slip {s['slip'] * 100:+.2f} %: {len(lines)} line(s) above the floor "
                     f"({', '.join(lines[:4])}); p = {s['p_value']:.2g} over {ev['n_spectra']} spectra; "
@@ -888,7 +897,7 @@ def _bearing_rows(job: _Job, f1: float, speed: dict):
                     f"claimed first in {s['votes']} spectra")
         else:
             note = "no comb in any envelope spectrum"
-        if name != "bearing_cage" and s.get("cage_floor_db") is not None:
+        if name != "bearing_cage" and s.get("cage_floor_db") is not None and not (sm is not None and sm["found"]):
             note += (f"; its lines are also harmonics of the cage comb, which stands up to "
                      f"{s['cage_floor_db']:.0f} dB there: they count only by what they stand above it")
         rows.append(_row(name, s["expected_hz"], s["found_hz"], s["amplitude"], s["evidence_db"], s["confidence"],
