@@ -1025,11 +1025,12 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
 # defect may spread over a few per cent where a race defect's, locked to the cage and the shaft, stay
 # sharp: the line test (2 bins a line) then sees nothing, and the envelope holds a hump at 2 x BSF and its
 # harmonics instead. The band-energy test below looks for that comb of humps; it is asked only where no
-# family's lines pass and none is significant (``_smeared_ball``). Measured (benchmarks/ball_smear.py):
-# with the races' lines and sidebands left out, the CWRU fan-end ball records B007_1, B014_1 and B007_2,
-# which show no line comb, stand at 1e-29, 1e-26 and 1e-12 (decoys at 1e-5 or less); every race record
-# real or synthetic at 1e-1.2 or more, healthy ones at 1e-2.5 or more. Without leaving the races out, race
-# records reach 1e-42: on the 6203, BPFO + 1X and BPFI - 1X lie 1.6 % and 1.0 % from 2 x BSF.
+# family's lines pass and no race family is significant (``_smeared_ball``). Measured on the channels'
+# mean (benchmarks/ball_smear.py, log10 p uncorrected): with the races' lines and sidebands left out, the
+# CWRU fan-end ball records B007_1, B014_1 and B007_2, which show no line comb, stand at -48, -35 and -21
+# (best decoy -14, -1.7, -3.6); every race record, real or synthetic, at -7.2 or above (MFPT's inner race
+# at load 3, whose BPFI is found first), healthy ones at -1.5 or above. Without leaving the races out,
+# race records reach -143 (IR021_0): on the 6203, BPFO + 1X and BPFI - 1X lie 1.6 % and 1.0 % from 2 x BSF.
 SMEAR_WIDTH = 0.015    # each hump: +-1.5 % of its centre
 SMEAR_EXCL = 0.01      # bins within 1 % of a race line (BPFO, BPFI x 1-12, with +-1X and +-2X) are left out
 SMEAR_FLOOR_HZ = 40.0  # the floor: a running median over +-40 Hz, wider than a hump
@@ -1124,8 +1125,8 @@ def _smeared_ball(spectra: list, freqs: dict, f1: float) -> dict | None:
     if len(views) > 1:
         n = min(r.size for r, _ in ratios)
         keep = np.all([k[:n] for _, k in ratios], axis=0)
-        fused = [s for s in spectra if s.prep == "cepstral (channels fused)"]
-        entries.append(("+".join(s.channel for s in views), "cepstral (channels fused)",
+        fused = [s for s in spectra if s.prep.startswith("cepstral (channels fused")]
+        entries.append(("+".join(s.channel for s in views), fused[0].prep if fused else "cepstral (channels fused)",
                         fused[0].band if fused else views[0].band,
                         np.mean([r[:n] for r, _ in ratios], axis=0), keep, float(len(views))))
     out = []
