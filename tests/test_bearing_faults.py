@@ -474,7 +474,7 @@ def test_overwhelming_evidence_in_one_view_is_called():
 def test_a_none_names_why_its_strongest_candidate_was_not_called(development_set):
     # B021_0 (fan-end ball fault, channel FE): a 2xBSF comb at p = 0.0011, above ALPHA, with only one of
     # its lines 7.8 dB above the floor and no +-FTF sideband (and no smeared comb: its humps stand at
-    # p = 0.08 uncorrected): the rule (p, two lines, the cage modulation of a ball defect) keeps it from
+    # p = 0.37 after the corrections): the rule (p, two lines, the cage modulation of a ball defect) keeps it from
     # a call, and the answer says which parts failed. (B007_2, this test's record before, is now called
     # ball from its smeared comb.)
     truth, d = development_set["B021_0.mat"]
@@ -663,9 +663,9 @@ def test_a_ball_whose_spin_wanders_is_called_from_its_smeared_comb():
 
 @pytest.mark.parametrize("name", ["B007_1.mat", "B007_2.mat", "B014_1.mat"])
 def test_fan_end_ball_records_rest_on_a_smeared_comb(development_set, name):
-    # no ball line comb passes on these (p 0.01-0.1, a line or none at 7.8 dB, no +-FTF sidebands); with
-    # the races' lines left out, humps at 2 x BSF x 1-3 stand at p 1e-19 to 1e-23 (corrected), the best
-    # of 16-19 decoy combs at 1e-4 or more
+    # no ball line comb passes the rule on these (p, lines at 7.8 dB, +-FTF sidebands); with the races'
+    # lines left out, humps at 2 x BSF x 1-3 stand at p 1e-19 to 1e-23 (corrected; measured with the
+    # fan-end channel primary), the best of 16-19 decoy combs at 1.7e-4 or more
     truth, d = development_set[name]
     row = d.faults.set_index("fault").loc["bearing_ball"]
     sm = d.extras["bearing"]["bearing_ball"]["smeared"]

@@ -1051,7 +1051,9 @@ def _wide_ratio(ses: _SES, freqs: dict, f1: float, races: bool = True) -> tuple[
     P = ses.amp[:n].astype(float) ** 2
     df = float(ses.freq[1])
     blk = max(1, int(round(2.0 / df)))
-    nb = max(1, n // blk)
+    nb = n // blk
+    if nb < 3:   # too short a spectrum for a floor of blocks: no bin is kept, no comb is found
+        return np.ones(n), np.zeros(n, bool)
     med = np.median(P[: nb * blk].reshape(nb, blk), axis=1)
     med = median_filter(med, size=2 * max(1, int(round(SMEAR_FLOOR_HZ / (blk * df)))) + 1, mode="nearest")
     floor = np.interp(np.arange(n), (np.arange(nb) + 0.5) * blk, med)
