@@ -1,4 +1,4 @@
-"""The measurement behind diagnose's smeared ball comb (``bearing_faults._smeared_ball``): does a ball
+"""The measurement behind diagnose's smeared ball comb (``bearing.smeared._smeared_ball``): does a ball
 defect whose 2 x BSF lines do not stand out leave a comb of humps (a few per cent wide) at 2 x BSF and its
 harmonics? A ball's spin wanders (its axis tilts, it skids), so its lines may spread over many bins where a
 race defect's, locked to the cage and the shaft, stay sharp.
@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 import vibmeasure as vm
-from vibmeasure.monitor import bearing_faults as bf
+from vibmeasure.monitor.bearing import smeared as bf
+from vibmeasure.monitor.bearing.spectra import _spectra
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from diagnosis_real import SHORT, records  # noqa: E402
@@ -32,7 +33,7 @@ def analyse(rec, rpm, bearing):
     """[(log10 p, best decoy log10 p)] with every bin kept, then with the races' lines left out."""
     f1 = rpm / 60
     freqs = vm.models.bearing.bearing_from(bearing).frequencies(f1)
-    views = [next(s for s in bf._spectra(rec.channel(c).astype(float), rec.fs, c, f1, freqs, None)[0]
+    views = [next(s for s in _spectra(rec.channel(c).astype(float), rec.fs, c, f1, freqs, None)[0]
                   if s.prep == "cepstral") for c in rec.names]
     decoys = bf._smear_decoys(freqs, f1)
     df = float(views[0].freq[1])

@@ -22,10 +22,10 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import vibmeasure as vm
-from vibmeasure.monitor import machinery
-from vibmeasure.monitor.bearing_faults import FAMILIES
+from vibmeasure.monitor.diagnosis import decide as machinery_decide
+from vibmeasure.monitor.bearing import FAMILIES
 from vibmeasure.monitor.calibration import NONE_BEARING, NONE_SHAFT, TABLE, UNCHECKED, fit_isotonic
-from vibmeasure.monitor.machinery import SHAFT_FAULTS
+from vibmeasure.monitor.diagnosis.shaft import SHAFT_FAULTS
 
 FAULTS = ["none", "unbalance", "misalignment", "looseness", "bearing_outer_race", "bearing_inner_race",
           "bearing_ball", "gear_mesh", "resonance"]
@@ -48,7 +48,7 @@ def one(job):
     fault, snr, duration, seed = job
     edge = snr in EDGE_SNRS   # teaches the NONE_BEARING map only
     warnings.simplefilter("ignore", vm.QualityWarning)
-    machinery.calibrated = lambda answer, score, group: score  # raw scores only: the map is being made
+    machinery_decide.calibrated = lambda answer, score, group: score  # raw scores only: the map is being made
     rec = vm.synth.machine(fault=fault, snr_db=snr, seed=1000 * (snr + 100) + 500 + seed, duration=duration)
     out = []
     for prefix, kw in (("", dict(bearing="6205-2RS")), (UNCHECKED, {})):

@@ -32,8 +32,10 @@ import scipy.io as sio
 from scipy import fft as sfft
 
 import vibmeasure as vm
-from vibmeasure.monitor.bearing_faults import ALPHA, FAMILIES, _SES, _family, _floor_ratio
-from vibmeasure.signal.kurtogram import _ses_power
+from vibmeasure.monitor.bearing import ALPHA, FAMILIES
+from vibmeasure.monitor.bearing.families import _family
+from vibmeasure.monitor.bearing.spectra import _SES, _floor_ratio
+from vibmeasure.signal.kurtogram import ses_power
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 CLASSES = ["bearing_outer_race", "bearing_inner_race", "bearing_ball", "other", "none"]
@@ -73,7 +75,7 @@ def reference(rec, rpm, bearing, channel):
     freqs = b.frequencies(f1)
     X = sfft.rfft(x - x.mean())
     f_need = 5 * max(freqs["BPFI"] + f1, freqs["2xBSF"] + freqs["FTF"])
-    freq, amp, f_valid = _ses_power(X, x.size, rec.fs, (2000.0, min(5000.0, 0.45 * rec.fs)), f_need)
+    freq, amp, f_valid = ses_power(X, x.size, rec.fs, (2000.0, min(5000.0, 0.45 * rec.fs)), f_need)
     df = freq[1]
     ses = _SES(channel, "raw 2-5 kHz", (2000.0, 5000.0), freq, amp,
                _floor_ratio(amp, df, max(5.0, 0.25 * f1)), min(freq.size, int(f_valid / df)))

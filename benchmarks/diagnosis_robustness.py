@@ -223,9 +223,9 @@ VARIANTS = {
 def main(names, guards=True):
     warnings.simplefilter("ignore", vm.QualityWarning)
     if not guards:
-        from vibmeasure.monitor import bearing_faults as bf
+        from vibmeasure.monitor.bearing import spectra as bf
         bf.TAPER = 0.0
-        bf._measured_top = lambda X, fs, n: fs / 2
+        bf.measured_top = lambda X, fs, n: fs / 2
     recs = [r for r in records() if r[0] in ("cwru_fe", "mfpt")]
     print(f"{'variant':52s} {'right':>6} {'none':>6} {'wrong':>6}  time   (guards {'on' if guards else 'off'})")
     total = dict.fromkeys(("right", "none", "wrong"), 0)

@@ -41,7 +41,7 @@ def test_library_never_prints():
     root = Path(vm.__file__).parent
     offenders = []
     for p in root.rglob("*.py"):
-        if p.name == "cli.py":
+        if p.parent.name == "cli":   # the command line's own package writes to the terminal
             continue
         for i, line in enumerate(p.read_text().splitlines(), 1):
             if re.match(r"\s*print\(", line):

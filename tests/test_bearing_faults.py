@@ -9,7 +9,20 @@ import pytest
 import scipy.io as sio
 
 import vibmeasure as vm
-from vibmeasure.monitor import bearing_faults as bf
+from types import SimpleNamespace
+
+from vibmeasure.monitor.bearing import cage, decoys, evidence, families, lines, rules, smeared, spectra
+
+STEPS = (rules, spectra, lines, cage, families, decoys, smeared, evidence)
+# the bearing test's steps, each from the module that holds it (unit tests of the statistics below)
+bf = SimpleNamespace(**{k: v for m in STEPS for k, v in vars(m).items() if not k.startswith("__")})
+
+
+def set_rule(monkeypatch, name, value):
+    """Change a rule (a constant or a helper) of the bearing test in every step module that uses it."""
+    for m in STEPS:
+        if hasattr(m, name):
+            monkeypatch.setattr(m, name, value)
 
 B6205 = vm.BEARINGS["6205-2RS"]
 F1 = 29.95
@@ -32,8 +45,8 @@ def test_false_alarm_rate_on_gaussian_noise(fs, n):
         x = np.random.default_rng(seed).normal(size=n)
         ev = bf.bearing_evidence({"acc": x}, fs, F1, freqs, 9)
         for name in bf.FAMILIES:
-            assert not ev["families"][name]["found"], (seed, name, ev["families"][name])
-            p.append(ev["families"][name]["p_value"])
+            assert not ev.families[name]["found"], (seed, name, ev.families[name])
+            p.append(ev.families[name]["p_value"])
     assert sum(pi < 0.05 for pi in p) <= 9
 
 
@@ -544,10 +557,10 @@ def test_a_record_resampled_to_48_khz_keeps_its_answer(shared_data, monkeypatch)
         band = d48.faults.set_index("fault").loc["bearing_outer_race"].band_hz
         assert band[1] <= 7500.0
         # the guards alone (a call in one spectrum would do: MIN_VOTES is a third guard, tested below)
-        monkeypatch.setattr(bf, "MIN_VOTES", 1)
-        monkeypatch.setattr(bf, "TAPER", 0.0)
+        set_rule(monkeypatch, "MIN_VOTES", 1)
+        set_rule(monkeypatch, "TAPER", 0.0)
         assert vm.diagnose(up, **kw).top == "bearing_outer_race"      # the measured band alone
-        monkeypatch.setattr(bf, "_measured_top", lambda X, fs, n: fs / 2)
+        set_rule(monkeypatch, "measured_top", lambda X, fs, n: fs / 2)
         assert vm.diagnose(up, **kw).top == "bearing_inner_race"      # neither guard
 
 
@@ -565,11 +578,11 @@ def test_a_strong_tone_does_not_make_a_bearing_call(shared_data, monkeypatch):
         warnings.simplefilter("ignore", vm.QualityWarning)
         assert vm.diagnose(rec, **kw).top == "none"
         assert vm.diagnose(noisy, **kw).top == "none"
-        monkeypatch.setattr(bf, "TAPER", 0.0)
+        set_rule(monkeypatch, "TAPER", 0.0)
         d = vm.diagnose(noisy, **kw)
         assert d.top == "none"   # the false comb shows in one spectrum only (MIN_VOTES)
         assert "one view of the record only" in d.faults.set_index("fault").loc["bearing_inner_race"].not_called
-        monkeypatch.setattr(bf, "MIN_VOTES", 1)
+        set_rule(monkeypatch, "MIN_VOTES", 1)
         assert vm.diagnose(noisy, **kw).top == "bearing_inner_race"
 
 

@@ -130,7 +130,7 @@ def test_a_none_on_real_ball_records_with_a_near_miss_is_not_confident(shared_da
 def test_report_flags_an_unlikely_none_for_a_look():
     # the HTML report's verdict: a "none" below 0.5 (here the buried resonance of seed 90804, 0.04) is
     # "watch", a confident one "ok"
-    from vibmeasure.reporting import diagnosis_section
+    from vibmeasure.reporting.sections import diagnosis_section
     warnings.simplefilter("ignore", vm.QualityWarning)
     classes = []
     for fault in ("resonance", "none"):

@@ -144,8 +144,8 @@ def test_spectrum_envelope_needs_band(sample_dir):
 def test_spectrum_errors_and_progress(sample_dir, monkeypatch, tmp_path):
     code, _, err = run(["spectrum", str(sample_dir / "machine.h5"), "--kind", "psd", "--nperseg", "100000"])
     assert code == 2 and "exceeds the record length" in err
-    import vibmeasure.cli as cli
-    monkeypatch.setattr(cli._Progress.__init__, "__defaults__", (0.0,))  # show at once
+    from vibmeasure.cli._common import Progress
+    monkeypatch.setattr(Progress.__init__, "__defaults__", (0.0,))  # show at once
     code, _, err = run(["spectrum", str(sample_dir / "machine.h5"), "--kind", "psd", "--nperseg", "256"])
     assert code == 0 and "psd [" in err and "100%" in err
 
@@ -205,9 +205,9 @@ def test_modes_errors(tmp_path):
 
 def test_every_option_of_every_command_has_help_text():
     import argparse
-    from vibmeasure.cli import _parser
+    from vibmeasure.cli.main import build_parser
     missing = []
-    for a in _parser()._actions:
+    for a in build_parser()._actions:
         if isinstance(a, argparse._SubParsersAction):
             for name, sp in a.choices.items():
                 missing += [(name, b.dest) for b in sp._actions

@@ -85,3 +85,44 @@ def test_the_gallery_draws_every_plot_it_shows(tmp_path):
     public = {n for n in dir(P) if n.startswith("plot_")}
     drawn = set(re.findall(r"\((plot_\w+)", " ".join(mod.PICTURES.values())))
     assert public <= drawn, f"plots missing from the gallery: {sorted(public - drawn)}"
+
+
+README = ROOT / "README.md"
+
+
+def test_every_example_of_the_readme_runs(reader_folder):
+    """The README's tour runs as written (python blocks in one namespace, `vibmeasure ...` lines through
+    the CLI), and the page stays a user's page: the two set-up commands first, at most 250 lines."""
+    from vibmeasure.cli import main
+    text = README.read_text()
+    assert len(text.splitlines()) <= 250
+    first = blocks(README)[0]
+    assert first[0] == "bash" and first[1].splitlines() == [
+        'python -m pip install -e . && vibmeasure demo', 'python -m pip install -e ".[test]" && python -m pytest']
+    ns: dict = {"__name__": "readme"}
+    for kind, code, line in blocks(README)[1:]:
+        if kind == "python":
+            with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
+                warnings.simplefilter("ignore")
+                try:
+                    exec(compile(code, f"{README.name}:{line}", "exec"), ns)
+                except Exception as exc:
+                    raise AssertionError(f"README.md block at line {line} failed: {exc!r}") from exc
+            continue
+        for cmd in code.splitlines():
+            cmd = cmd.split("#")[0].strip()
+            if cmd.startswith("vibmeasure "):
+                out, err = io.StringIO(), io.StringIO()
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    rc = main(shlex.split(cmd)[1:], out=out, err=err)
+                assert rc == 0, f"README.md line {line}: {cmd!r} exited {rc}: {err.getvalue()[-500:]}"
+    assert ns["modes"].n_modes == 3 and ns["diag"].top == "bearing_outer_race"
+
+
+def test_every_link_of_the_readme_and_docs_resolves():
+    for page in [README, *sorted((ROOT / "docs").rglob("*.md")), ROOT / "CHANGELOG.md"]:
+        for target in re.findall(r"\]\(([^)#:]+)\)", page.read_text()):
+            if target.endswith(".png"):   # the gallery's pictures are drawn by docs/make_gallery.py
+                continue
+            assert (page.parent / target).exists(), f"{page.name}: link {target} does not resolve"

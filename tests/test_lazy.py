@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import vibmeasure as vm
-import vibmeasure.signal.spectral as spectral
+import vibmeasure.signal.segments as spectral
 
 
 def test_open_own_schema_and_stream_psd(tmp_path, rng, monkeypatch):

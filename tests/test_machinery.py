@@ -491,7 +491,7 @@ def test_which_speeds_are_confirmed_for_the_bearing_analysis():
     # the rule itself (ONE_X_CONFIRMS = 2): a 1X within SPEED_NOTED (1 %) of the declared speed, or one
     # further off with two of its harmonics, confirms the speed; a measured speed (tachometer, profile, the
     # 1X's own curve) is confirmed whatever was declared; no 1X, or one off it with fewer harmonics, is not
-    from vibmeasure.monitor.machinery import _confirmed
+    from vibmeasure.monitor.diagnosis.speed import _confirmed
     base = {"declared_rpm": 1800.0}
     assert _confirmed(dict(base, estimated_rpm=1800 * 1.009, one_x_harmonics=0))
     assert _confirmed(dict(base, estimated_rpm=1919.0, one_x_harmonics=2))
@@ -532,7 +532,7 @@ def _with_mains(rec, line_hz, amp=0.3):
 
 
 def test_a_line_at_the_mains_frequency_is_electrical():
-    from vibmeasure.monitor import machinery as mm
+    from vibmeasure.monitor.diagnosis import mains as mm
     assert mm._at_mains(50.1, 0.1) and mm._at_mains(59.8, 0.1) and mm._at_mains(100.3, 0.1)
     assert not mm._at_mains(49.5, 0.1) and not mm._at_mains(150.0, 0.1) and not mm._at_mains(59.17, 0.5)
     assert mm._at_mains(50.0, 0.1, (50.0,)) and not mm._at_mains(60.0, 0.1, (50.0,))
@@ -645,7 +645,7 @@ def test_a_record_filtered_below_the_demodulation_region_is_flagged():
     d = vm.diagnose(vm.Record.from_array(y, fs=orr.fs, unit="g", names=["acc"]), rpm=orr.meta["rpm"],
                     bearing="6205-2RS")
     assert d.top == "none" and "band_limited" in d.flags and d.confidence < 0.5
-    from vibmeasure.reporting import diagnosis_section
+    from vibmeasure.reporting.sections import diagnosis_section
     sec = diagnosis_section(vm.Record.from_array(y, fs=orr.fs, unit="g", names=["acc"]), d, "low-passed")
     assert sec["verdict_class"] == "watch" and [f["flag"] for f in sec["flags"]] == ["band_limited"]
     assert "sample faster" in sec["flags"][0]["advice"] and "filter's edge" in sec["flags"][0]["text"]
@@ -772,7 +772,7 @@ def test_cwru_records_run_at_a_steady_speed(shared_data):
     # the 1X of the drive-end records follows no curve over 8 parts: the fitted curve spans under
     # 0.5 % (measured; at most 0.72 % on any channel of the development set) and a constant speed
     # would scatter so by chance with p > 0.01; a varying speed is said from 2 % with p < 0.001
-    from vibmeasure.monitor.machinery import DRIFT_P, SPEED_DRIFT, _speed_drift
+    from vibmeasure.monitor.diagnosis.tracking import DRIFT_P, SPEED_DRIFT, _speed_drift
     for key in ("IR", "OR", "B"):
         rec = cwru(shared_data, key)
         lo, hi, spread, p, _ = _speed_drift(rec.data[0], rec.fs, rec.meta["rpm"] / 60)
@@ -787,7 +787,7 @@ def test_shaft_harmonics_that_carry_little_of_the_level_are_no_looseness(shared_
     knock that hid the bearing's evidence no longer makes it the answer. A synthetic looseness machine
     at -10 dB carries 57-61 % (full weight) and is still called."""
     import scipy.io as sio
-    from vibmeasure.monitor import shaft_faults
+    from vibmeasure.monitor.diagnosis import shaft as shaft_faults
     f = shared_data("mfpt/OuterRaceFault_vload_3.mat")
     rate = float(sio.loadmat(f, squeeze_me=True)["bearing"]["rate"].item())
     rec = vm.read(f, channels=["bearing.gs"], unit="g")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import vibmeasure as vm
-from vibmeasure.monitor import machinery as M
+from vibmeasure.monitor.diagnosis import mains as M
 from vibmeasure.signal.quality import clipped_share
 
 G = 9.80665

@@ -91,7 +91,7 @@ def test_efdd_removes_the_bias_of_cutting_the_bell():
     # lines the benchmark's 57 Hz, 2 % mode keeps (54.6-66.6 Hz at fs 200, 8192-sample segments).
     # The plain EFDD fit of the cut bell is 8 % low in zeta (the cut smears the correlation function);
     # corrected it must be within 0.1 % (measured 0.01 %) and fn within 1e-5 (measured 8e-7)
-    from vibmeasure.identify.oma_fdd import _efdd, _efdd_fit
+    from vibmeasure.identify.oma.fdd import _efdd, _efdd_fit
     fs, nper, fn, z = 200.0, 8192, 57.2667, 0.02
     w = np.hanning(nper + 1)[:-1]
     f = np.fft.rfftfreq(2 * nper, 1 / fs)

@@ -10,7 +10,7 @@ import scipy.io as sio
 
 import vibmeasure as vm
 from vibmeasure.signal import quality as q
-import vibmeasure.monitor.machinery as M
+import vibmeasure.monitor.diagnosis.decide as M
 
 
 def _machine(fault="none", seed=900, **kw):
@@ -48,7 +48,7 @@ def test_a_regular_spike_train_is_found_whole_on_its_grid(rng):
     y[idx] += rng.uniform(6, 40, idx.size) * q._residual(x)[1]
     strict = q._spikes_once(y, q.SPIKE_SIGMA, q.SPIKE_ISOLATION)
     assert 5 <= strict.size <= 0.9 * idx.size   # the single test misses the smaller ones ...
-    assert q._grid(strict) == (300, 1024)       # ... but sees the grid
+    assert q.spike_grid(strict) == (300, 1024)       # ... but sees the grid
     np.testing.assert_array_equal(q.isolated_spikes(y), idx)
 
 
@@ -557,7 +557,7 @@ def test_a_sensor_settling_is_no_looseness_and_lifts_the_severity_far_less(share
     without the gate, is 1.7 x with it: the settling's tail under the offset threshold still carries
     low frequencies (a limit, asserted as such: under 2.5 x, and over 10 x without the gate). Without
     the gate "looseness" is no longer called either: its harmonics carry a small share of the velocity
-    power the settling makes (``shaft_faults.SHAFT_SHARE``), so its score stays under TOP_CONFIDENCE."""
+    power the settling makes (``diagnosis.shaft.SHAFT_SHARE``), so its score stays under TOP_CONFIDENCE."""
     rec = vm.read(shared_data("cwru_fe/B007_0.mat"), fs=12000, unit="g")
     fe = next(n for n in rec.names if n.endswith("_FE_time"))   # the fault-side channel, as diagnosis_real
     t = np.arange(rec.n_samples) / rec.fs

@@ -68,7 +68,7 @@ def test_psd_removes_large_offsets_like_welch(rng, monkeypatch, nperseg, noverla
     # summing segments (parts of gcd(step, nperseg) samples; plain sums for 777/300). The mean is
     # taken out of the lines the window's transform touches after the FFT, from values ~offset x N:
     # cancellation leaves ~1e-12 of the line (welch subtracts before windowing): 1e-9
-    import vibmeasure.signal.spectral as sp
+    import vibmeasure.signal.segments as sp
     monkeypatch.setattr(sp, "READ_SAMPLES", 30_000)
     x = rng.normal(size=(2, 100_003)) + np.array([[40.0], [-2.0e3]])
     ours = vm.psd(vm.Record(x, fs=FS), nperseg=nperseg, noverlap=noverlap)
@@ -93,7 +93,7 @@ def test_psd_from_several_threads_at_once(rng):
 
 
 def test_work_buffers_kept_only_when_small():
-    import vibmeasure.signal.spectral as sp
+    import vibmeasure.signal.segments as sp
     a = sp._scratch("probe", (16, 4096), np.float64)
     assert sp._scratch("probe", (16, 4096), np.float64) is a          # reused: no fresh pages per call
     big = (16, sp.SCRATCH_BYTES // 8)                                    # 16 x 4 MB: allocated per call

@@ -96,7 +96,7 @@ def test_impacts_stand_at_their_exact_times():
     # with a rub were called inner race). Placed at their exact times (band-limited), those lines are
     # more than 50 dB down
     from scipy.signal import hilbert
-    from vibmeasure.synth import _impact_train
+    from vibmeasure.synth.machine import _impact_train
     fs, f1, T = 12000.0, 1797 / 60, 10.0
     n = int(fs * T)
     x = _impact_train(n, fs, np.arange(0.0, T, 1 / f1), 3500.0)

@@ -5,7 +5,7 @@ import pytest
 from scipy import signal as sg
 
 import vibmeasure as vm
-from vibmeasure.signal.whiten import _edit_lines
+from vibmeasure.signal.whiten import edit_lines
 
 
 def test_cepstral_prewhitening_flattens_the_magnitude(rng):
@@ -49,7 +49,7 @@ def test_edit_lines_keeps_random_content_and_cuts_tones(rng):
     fs, n = 5000.0, 50000
     t = np.arange(n) / fs
     noise = rng.normal(size=n)
-    y = _edit_lines(noise + 20 * np.sin(2 * np.pi * 123.4 * t))
+    y = edit_lines(noise + 20 * np.sin(2 * np.pi * 123.4 * t))
     P = np.abs(np.fft.rfft(y)) ** 2
     k = int(round(123.4 * n / fs))
     assert P[k - 2: k + 3].max() < 20 * np.median(P)   # the tone is cut to the local level
@@ -82,10 +82,10 @@ def _lowpassed(fc_frac, fs=12000.0, n=2 ** 17, seed=0, floor_db=-100.0):
 
 
 def test_a_record_with_content_up_to_nyquist_keeps_its_whole_band():
-    from vibmeasure.signal.whiten import _measured_top
+    from vibmeasure.signal.whiten import measured_top
     for seed in range(5):
         x = np.random.default_rng(seed).normal(size=2 ** 17)
-        assert _measured_top(np.fft.rfft(x), 12000.0, x.size) == 6000.0
+        assert measured_top(np.fft.rfft(x), 12000.0, x.size) == 6000.0
 
 
 @pytest.mark.parametrize("fc_frac", [0.25, 0.5, 0.8])
@@ -95,9 +95,9 @@ def test_the_measured_band_ends_where_the_anti_alias_filter_has_cut_25_db(fc_fra
     # bands of fs/1024 smoothed over 5, and the mean level under the cut takes in part of the
     # filter's own transition (measured: +0.2 % to +2.3 % over three seeds)
     from scipy.signal import butter, sosfreqz
-    from vibmeasure.signal.whiten import DEAD_DB, _measured_top
+    from vibmeasure.signal.whiten import DEAD_DB, measured_top
     x, fs = _lowpassed(fc_frac)
-    top = _measured_top(np.fft.rfft(x), fs, x.size)
+    top = measured_top(np.fft.rfft(x), fs, x.size)
     f, h = sosfreqz(butter(8, fc_frac * fs / 2, fs=fs, output="sos"), worN=2 ** 16, fs=fs)
     f_cut = f[np.argmax(40 * np.log10(np.maximum(np.abs(h), 1e-30)) < -DEAD_DB)]
     assert 0.98 * f_cut <= top <= 1.05 * f_cut
@@ -106,9 +106,9 @@ def test_the_measured_band_ends_where_the_anti_alias_filter_has_cut_25_db(fc_fra
 def test_a_lone_tone_in_the_stop_band_does_not_reopen_it():
     # a converter spur 20 dB above the pass band's spectral level, alone in the stop band: one band of
     # 512 is loud, its running median over 5 neighbours is not
-    from vibmeasure.signal.whiten import _measured_top
+    from vibmeasure.signal.whiten import measured_top
     x, fs = _lowpassed(0.4)
     t = np.arange(x.size) / fs
-    clean = _measured_top(np.fft.rfft(x), fs, x.size)
+    clean = measured_top(np.fft.rfft(x), fs, x.size)
     spur = x + 0.05 * np.sin(2 * np.pi * 5000.0 * t)
-    assert _measured_top(np.fft.rfft(spur), fs, x.size) == pytest.approx(clean, abs=30.0)
+    assert measured_top(np.fft.rfft(spur), fs, x.size) == pytest.approx(clean, abs=30.0)

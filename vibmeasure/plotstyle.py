@@ -1,6 +1,6 @@
 """The one look of every vibmeasure figure: matplotlib settings and the meaning of colours.
 
-plot.py applies :data:`STYLE` around each public plotting function (``matplotlib.rc_context``), so
+vibmeasure.plot applies :data:`STYLE` around each public plotting function (``matplotlib.rc_context``), so
 a figure made in a script, by the command line or inside an HTML report looks the same. Nothing
 here imports matplotlib; the settings are plain names and values.
 

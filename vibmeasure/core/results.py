@@ -11,7 +11,7 @@ import numpy as np
 
 from .errors import ParameterError
 
-__all__ = ["ModalEstimate", "Spectrum", "Spectrogram", "Peaks", "FRF", "Kurtogram", "FLAG_TEXT"]
+__all__ = ["ModalEstimate", "Spectrum", "Spectrogram", "Peaks", "FRF", "Kurtogram", "FLAG_TEXT", "jsonable", "Diagnosis"]
 
 # Every quality flag a result may carry, with the sentence a report prints for it.
 FLAG_TEXT = {
@@ -137,7 +137,7 @@ class ModalEstimate:
         """JSON-ready dict: ``modes`` (list of per-mode dicts), ``method``, ``flags``, ``unit``, ``extras``."""
         return {"method": self.method, "flags": list(self.flags), "unit": self.unit,
                 "modes": [self.mode(i) for i in range(self.n_modes)],
-                "extras": _jsonable(dict(self.extras))}
+                "extras": jsonable(dict(self.extras))}
 
     def to_frame(self):
         """A pandas table, one row per mode."""
@@ -161,24 +161,26 @@ def _num(x):
 _PLAIN = (str, int, bool, type(None))
 
 
-def _jsonable(obj):
+def jsonable(obj):
+    """obj with numpy scalars and arrays, tuples, NaN and inf turned into what ``json.dumps`` writes
+    (lists, floats, None): the one conversion every ``to_dict`` and the CLI's ``--json`` use."""
     t = type(obj)
     if t in _PLAIN:   # the common leaves first: no abstract-class checks (a batch converts ~10^5 values)
         return obj
     if t is float:
         return obj if math.isfinite(obj) else None
     if t is dict:
-        return {str(k): _jsonable(v) for k, v in obj.items()}
+        return {str(k): jsonable(v) for k, v in obj.items()}
     if t is list or t is tuple:
-        return [_jsonable(v) for v in obj]
+        return [jsonable(v) for v in obj]
     if hasattr(obj, "to_dict") and hasattr(obj, "columns"):  # a pandas DataFrame: its rows
-        return [_jsonable(r) for r in obj.to_dict(orient="records")]
+        return [jsonable(r) for r in obj.to_dict(orient="records")]
     if isinstance(obj, Mapping):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
+        return {str(k): jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
+        return [jsonable(v) for v in obj]
     if isinstance(obj, np.ndarray):
-        return [_jsonable(v) for v in obj.tolist()]
+        return [jsonable(v) for v in obj.tolist()]
     if isinstance(obj, (float, np.floating)):
         return _num(obj)
     if isinstance(obj, (np.integer,)):
@@ -474,3 +476,77 @@ class Kurtogram:
         for r, (nb, vals) in enumerate(zip(self.n_bands, rows)):
             out[r] = vals[np.minimum((np.arange(n_cols) * nb) // n_cols, nb - 1)]
         return out
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """A machine diagnosis (``vm.diagnose``).
+
+    Attributes
+    ----------
+    top : str
+        The answer: none, unbalance, misalignment, looseness, bearing_outer_race, bearing_inner_race,
+        bearing_ball, gear_mesh, resonance or electrical.
+    confidence : float
+        The probability that ``top`` is right, calibrated on synthetic machines
+        (monitor/calibration.py); ``extras["score"]`` is the raw evidence score it was mapped from.
+    reason : str
+        Why, in words: the evidence, the strongest candidate of a "none", what was not checked.
+    faults : pandas.DataFrame
+        One row per fault family: evidence, p-value (bearing families), channel, pre-processing, band.
+    speed : dict
+        Declared and estimated rpm, the 1X line's height, consistency with fs and the note.
+    severity : dict
+        ISO 10816-3 velocity RMS (mm/s), its band, group, foundation and zone.
+    envelope_band_hz : tuple
+        The demodulation band of the envelope spectrum that carries the top (or strongest) bearing family.
+    flags : tuple of str
+        Quality flags (``speed_corrected``, ``unit_unknown``, ``band_limited``, ...).
+    extras : dict
+        The bearing test per family, that envelope spectrum and the kurtogram (for plots), the data
+        quality findings.
+    channel : str
+        The channel that carries the top's evidence.
+    bearing_checked : bool
+        False without a bearing, or where the declared speed is contradicted.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.machine(fault="unbalance", rpm=1797, duration=4.0, seed=1)
+    >>> d = vm.diagnose(rec, rpm=1797, bearing="6205-2RS")
+    >>> d.top
+    'unbalance'
+    """
+
+    top: str
+    confidence: float
+    reason: str
+    faults: object
+    speed: dict
+    severity: dict
+    envelope_band_hz: tuple
+    flags: tuple = ()
+    extras: dict = field(default_factory=dict)
+    channel: str = ""
+    bearing_checked: bool = False
+
+    def to_dict(self) -> dict:
+        """The diagnosis as plain JSON-ready values (the CLI's ``--json`` document).
+
+        Returns
+        -------
+        dict
+            top, confidence, score, reason, channel, bearing_checked, faults (records), speed,
+            severity, envelope_band_hz, flags, also, measured_top_hz.
+        """
+        return jsonable({"top": self.top, "confidence": self.confidence, "score": self.extras.get("score"),
+                         "reason": self.reason,
+                         "channel": self.channel, "bearing_checked": self.bearing_checked,
+                         "faults": self.faults.to_dict(orient="records"), "speed": self.speed,
+                         "severity": self.severity, "envelope_band_hz": list(self.envelope_band_hz),
+                         "flags": list(self.flags), "also": list(self.extras.get("also", ())),
+                         "measured_top_hz": self.extras.get("measured_top_hz")})
+
+    def __repr__(self) -> str:
+        return f"Diagnosis(top={self.top!r}, confidence={self.confidence:.2f}: {self.reason})"

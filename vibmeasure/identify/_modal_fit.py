@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 
 from ._poles import pole_to_modal
+from .limits import MAX_REL_ZETA_STD
 
 STABLE_DF = 0.01     # pole frequency within 1 % of one at the previous order
 STABLE_DZ = 0.05     # and damping within 5 %
 FALSE_ALARM = 0.01          # chance per fit that noise alone passes the amplitude test for a mode
-MAX_REL_ZETA_STD_FRF = 0.3  # the limit ringdown uses: a damping this uncertain is not a measurement
 DETECT_FRF = 30.0  # a mode found in the residual must lower the weighted residual sum of squares this much
 
 
@@ -244,7 +244,7 @@ def _unsupported(theta, coef, cov, sw, tau, n_lines, n_out, band, df):
     A mode is kept when (1) its residues are significant: the Wald statistic of its 2 n_out real
     residue coefficients exceeds the chi-square level whose false-alarm chance is FALSE_ALARM
     divided by the lines searched (the pole's place was chosen among them: Bonferroni); and (2)
-    its zeta is known to better than MAX_REL_ZETA_STD_FRF (relative std); (3) no stronger mode lies
+    its zeta is known to better than MAX_REL_ZETA_STD (relative std); (3) no stronger mode lies
     within two lines of it. Poles outside the band
     or with zero, negative or over-critical damping are left to the physical screen."""
     from scipy.stats import chi2
@@ -272,8 +272,8 @@ def _unsupported(theta, coef, cov, sw, tau, n_lines, n_out, band, df):
         if not wald > level:
             why = (f"amplitude not significant: Wald {wald:.3g} <= {level:.3g} (chi-square, {2 * n_out} dof, "
                    f"false-alarm {FALSE_ALARM:g} per fit over {n_lines} lines)")
-        elif not zeta_std <= MAX_REL_ZETA_STD_FRF * zeta:
-            why = f"damping too uncertain: zeta {zeta:.3g} +- {zeta_std:.2g} (relative std above {MAX_REL_ZETA_STD_FRF})"
+        elif not zeta_std <= MAX_REL_ZETA_STD * zeta:
+            why = f"damping too uncertain: zeta {zeta:.3g} +- {zeta_std:.2g} (relative std above {MAX_REL_ZETA_STD})"
         if why:
             out.append((k, {"fn_hz": float(fn), "zeta": float(zeta), "zeta_std": float(zeta_std),
                             "wald": wald, "reason": why}))

@@ -15,7 +15,8 @@ from ..core._validate import as_record
 from ..core.errors import ParameterError, warn_quality
 from ..core.record import Record
 from ..core.results import FRF, form_of
-from ..signal.spectral import _check_params, _segment_sums, get_window
+from ..signal.segments import segment_sums
+from ..signal.spectral import check_segment_params, get_window
 from ._decay import clipped_mask
 
 __all__ = ["estimate_frf", "impact_frf", "find_hits", "form_of"]
@@ -134,7 +135,7 @@ def estimate_frf(rec, *, input="force", outputs=None, estimator: str = "H1", npe
     if estimator not in ("H1", "H2", "Hv"):
         raise ParameterError(f"estimator={estimator!r} must be 'H1', 'H2' or 'Hv'")
     ii, oo = _io(rec, input, outputs)
-    nperseg, noverlap, nfft = _check_params(rec.n_samples, nperseg, noverlap, None, detrend, "mean",
+    nperseg, noverlap, nfft = check_segment_params(rec.n_samples, nperseg, noverlap, None, detrend, "mean",
                                             min(rec.n_samples // 4, 4096) or 2)
     win = get_window(window, nperseg)
     idx = ii + oo
@@ -148,7 +149,7 @@ def estimate_frf(rec, *, input="force", outputs=None, estimator: str = "H1", npe
         @staticmethod
         def read(a, b):
             return rec.data[:, a:b]
-    autos, cross, nseg, _ = _segment_sums(_Src, idx, nperseg=nperseg, noverlap=noverlap, nfft=nfft, win=win,
+    autos, cross, nseg, _ = segment_sums(_Src, idx, nperseg=nperseg, noverlap=noverlap, nfft=nfft, win=win,
                                           detrend=detrend, pairs=pairs, progress=progress)
     if nseg < 2:
         raise ParameterError(f"nperseg={nperseg} gives {nseg} average: coherence and H need at least 2; "

@@ -16,15 +16,14 @@ import numpy as np
 from ..core._threads import single_threaded
 from ..core._validate import check_band, name_index
 from ..core.errors import FitError, ParameterError, warn_quality
-from ..core.results import FRF, ModalEstimate, Spectrum
-from ._modal_fit import (FALSE_ALARM, MAX_REL_ZETA_STD_FRF, _covariance, _full_jacobian,  # noqa: F401 (tests, modal_crb)
+from ..core.results import FRF, ModalEstimate
+from ._modal_fit import (FALSE_ALARM, MAX_REL_ZETA_STD, _covariance, _full_jacobian,  # noqa: F401 (tests, modal_crb)
                          _lam, _lscf_poles, _polish, _residual_search, _residual_terms, _stabilise, _unsupported,
                          synthesize_frf_from)
 from ._poles import pole_to_modal
 
-__all__ = ["fit_modes", "half_power_frf", "circle_fit", "mac", "synthesize_frf", "modal_crb"]
+__all__ = ["fit_modes", "circle_fit", "synthesize_frf", "modal_crb"]
 
-MIN_LINES_OK = 10    # half-power bandwidth spanned by fewer lines: resolution-limited
 MIN_LINES_WINDOWED = 8
 
 
@@ -272,7 +271,7 @@ def _fit_extras(frf, f, H, ii, band, m: _Poles, coef, sw, keep, table, n_orders,
               "stabilisation": table, "n_orders": n_orders, "exp_window_tau_s": tau,
               "exp_window_added_zeta": [float(1 / (tau * m.wn[k])) for k in keep] if tau else None,
               "dropped_poles": dropped, "rejected_modes": rejected,
-              "mode_test": {"false_alarm_rate": FALSE_ALARM, "max_rel_zeta_std": MAX_REL_ZETA_STD_FRF},
+              "mode_test": {"false_alarm_rate": FALSE_ALARM, "max_rel_zeta_std": MAX_REL_ZETA_STD},
               "outputs": list(frf.outputs), "form": frf.form,
               "input": [frf.inputs[i] for i in ii] if poly is not None else frf.inputs[ii]}
     if poly is not None:
@@ -314,17 +313,6 @@ def synthesize_frf(est: ModalEstimate, freq, *, residuals: bool = False) -> np.n
     return np.asarray(out)
 
 
-def mac(a, b=None) -> np.ndarray:
-    """Modal assurance criterion between the columns of a and b (n_dof, n_modes): |a^H b|^2 / (|a|^2 |b|^2)."""
-    a = np.asarray(a, complex)
-    b = a if b is None else np.asarray(b, complex)
-    if a.ndim != 2 or b.ndim != 2 or a.shape[0] != b.shape[0]:
-        raise ParameterError(f"mac needs two (n_dof, n_modes) arrays with equal n_dof, got {a.shape} and {b.shape}")
-    num = np.abs(a.conj().T @ b) ** 2
-    den = np.outer(np.sum(np.abs(a) ** 2, 0), np.sum(np.abs(b) ** 2, 0))
-    return num / den
-
-
 def modal_crb(freq, *, fn, zeta, residues, noise_std) -> dict:
     """Cramer-Rao bound on fn and zeta for FRFs in complex Gaussian noise (std noise_std per output,
     E|n|^2 = s^2), from the Fisher information of the modal model with complex residues (the same
@@ -353,86 +341,6 @@ def modal_crb(freq, *, fn, zeta, residues, noise_std) -> dict:
     cov = np.linalg.inv(J.T @ J)
     stds = np.array([pole_to_modal(sig[k], wd[k], cov[2 * k:2 * k + 2, 2 * k:2 * k + 2])[2:] for k in range(fn.size)])
     return {"fn_std": stds[:, 0], "zeta_std": stds[:, 1]}
-
-
-# ------------------------------------------------------------------------------------------------
-def _zeta_from_points(w1, w2, form):
-    if form == "mobility":
-        zeta = (w2 - w1) / (2 * np.sqrt(w1 * w2))
-        wn = np.sqrt(w1 * w2)
-        return zeta, wn
-    rho = (w2 ** 2 - w1 ** 2) / (w2 ** 2 + w1 ** 2)
-    zeta = np.sqrt(0.5 * (1 - 1 / np.sqrt(1 + rho ** 2)))
-    if form == "accelerance":
-        wn = np.sqrt(2 * (1 - 2 * zeta ** 2) / (1 / w1 ** 2 + 1 / w2 ** 2))
-    else:
-        wn = np.sqrt((w1 ** 2 + w2 ** 2) / (2 * (1 - 2 * zeta ** 2)))
-    return zeta, wn
-
-
-def half_power_frf(obj, *, band=None, output=0, input=0) -> ModalEstimate:
-    """Half-power bandwidth of one FRF (or a magnitude spectrum) peak, with the exact relations.
-
-    Mobility: zeta = (f2 - f1) / (2 sqrt(f1 f2)). Receptance and accelerance: with
-    rho = (f2^2 - f1^2) / (f2^2 + f1^2), zeta = sqrt((1 - 1/sqrt(1 + rho^2)) / 2) (exact for one
-    mode; (f2 - f1)/(2 f_peak) would overestimate by about 2 zeta^2 and 4 zeta^2). Crossings are
-    interpolated in |H|^2. Refused when the lower half-power point does not exist (zeta > 0.38) or
-    the bandwidth spans fewer than 3 lines; flagged below 10 lines and when another peak is near.
-    A spectrum is treated as accelerance when it measures acceleration, else as receptance.
-    """
-    if isinstance(obj, FRF):
-        o = name_index(obj.outputs, output, what="output")
-        i = name_index(obj.inputs, input, what="input")
-        freq, P, form = obj.freq, np.abs(obj.h[o, i]) ** 2, obj.form
-        coh = obj.coherence[o] if obj.coherence is not None else None
-    elif isinstance(obj, Spectrum):
-        freq = obj.freq
-        ch = name_index(obj.channels, output, what="channel")
-        v = np.abs(obj.values[ch])
-        P = v if obj.kind in ("psd", "power") else v ** 2
-        form = "accelerance" if obj.quantity == "acceleration" else "receptance"
-        coh = None
-    else:
-        raise ParameterError(f"half_power takes a vm.FRF, a vm.Spectrum or a ring-down vm.Record, "
-                             f"got {type(obj).__name__}")
-    if form == "unknown":
-        form = "receptance"
-    if not np.isfinite(P).all():
-        raise ParameterError("the FRF/spectrum has NaN/inf lines")
-    sel = np.ones(freq.size, bool) if band is None else (freq >= band[0]) & (freq <= band[1])
-    sel &= freq > 0
-    if not sel.any():
-        raise ParameterError(f"band={band!r} holds no line of the data")
-    from .damping import half_power_crossings
-    k = int(np.flatnonzero(sel)[np.argmax(P[sel])])
-    f1, f2, lo, hi = half_power_crossings(freq, P, k, lower_msg="the lower half-power point does not exist "
-                                          "(zeta > 0.38, or the peak sits at the start of the data)")
-    df = float(freq[1] - freq[0])
-    lines = (f2 - f1) / df
-    if lines < 3:
-        raise FitError(f"half_power: the half-power bandwidth spans {lines:.2g} lines (< 3): the resolution "
-                       f"({df:.4g} Hz) cannot measure zeta; use vm.fit_modes or a finer resolution")
-    zeta, wn = _zeta_from_points(2 * np.pi * f1, 2 * np.pi * f2, form)
-    flags = []
-    if lines < MIN_LINES_OK:
-        flags.append("resolution_limited")
-    # another peak within three bandwidths?
-    bw = f2 - f1
-    near = (np.abs(freq - freq[k]) > bw) & (np.abs(freq - freq[k]) < 3 * bw + bw)
-    if near.any():
-        idx = np.flatnonzero(near)
-        loc = [j for j in idx if 0 < j < P.size - 1 and P[j] >= P[j - 1] and P[j] >= P[j + 1] and P[j] > 0.25 * P[k]]
-        if loc:
-            flags.append("close_modes")
-    if coh is not None and np.mean(coh[lo:hi + 1]) < 0.8:
-        flags.append("low_coherence")
-    est = ModalEstimate(fn=[wn / (2 * np.pi)], zeta=[zeta], fn_std=[np.nan], zeta_std=[np.nan], method="halfpower",
-                        flags=tuple(flags), extras={"f1_hz": float(f1), "f2_hz": float(f2), "lines": float(lines),
-                                                    "form": form, "peak_hz": float(freq[k]),
-                                                    "std": "the half-power method gives no statistical std"})
-    if flags:
-        warn_quality(f"half_power: {', '.join(flags)} ({lines:.3g} lines across the half-power band)", stacklevel=3)
-    return est
 
 
 def _circle_angles_fit(w, ang, wn0, zeta0, a0):

@@ -32,11 +32,11 @@ from ._rd_checks import (_add_backbone, _amplitude_check, _coulomb_check, _domin
 from ._rd_ml import (_colored_noise_scale, _evaluate, _lm, _mode_energy, _mode_model, _mode_shares,  # noqa: F401
                      _pack, ringdown_crb)  # ringdown_crb: public here too
 from ._rd_start import SUBSAMPLE, _esprit, _linear_amplitudes, _spectral_candidates
+from .limits import MAX_REL_ZETA_STD
 
 __all__ = ["ringdown", "ringdown_crb"]
 
 DETECT = 50.0          # a mode must carry this many times the per-sample noise variance in energy
-MAX_REL_ZETA_STD = 0.3  # refuse a mode whose zeta is this uncertain (relative std)
 FEW_CYCLES = 5
 MIN_FS_OVER_FN = 10.0
 NUM_FLOOR = 1e-9  # relative to the peak: below this, 'noise' is rounding and modes are artefacts

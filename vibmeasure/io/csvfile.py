@@ -71,14 +71,40 @@ def _check_digest(text: str, src: str) -> None:
 
 
 def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
-    import pandas as pd
     src = f"CSV file {str(path)!r}"
     try:
         text = Path(path).read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise ParameterError(f"{src} is not UTF-8 text: unreadable as CSV") from None
     _check_digest(text, src)
-    lines = _cut_last_line(text, src).splitlines()
+    header_kv, chan_meta, body = _header_and_body(_cut_last_line(text, src).splitlines(), src)
+    values, labels, has_header = _table(body, src, max_samples)
+    _check_rows(values, has_header, header_kv, src)
+    split = [_split_name_unit(lab) for lab in labels]
+    names, units = [nm for nm, _ in split], [un for _, un in split]
+    tcol = next((i for i, n in enumerate(names) if n.lower() in _TIME_NAMES), None)
+    fs, t0 = _timing(values, units, tcol, header_kv, fs, src)
+    data_cols = [i for i in range(len(names)) if i != tcol]
+    if not data_cols:
+        raise ParameterError(f"{src} has a time column but no data column")
+    locations = _exact_channels(header_kv, names, data_cols, chan_meta, src)
+    avail = [names[i] for i in data_cols]
+    pick = [data_cols[j] for j in select_names(avail, channels, source=src)]
+    quantities = [chan_meta.get(names[i], ("unknown", ""))[0] for i in pick]
+    file_units = [chan_meta.get(names[i], (None, units[i] or ""))[1] for i in pick]
+    meta = {k: v for k, v in header_kv.items() if k not in _FS_KEYS and k not in ("t0_s", "n_samples", "channels_json")}
+    meta["source"] = str(path)
+    rec = make_record(values[:, pick].T, fs, [names[i] for i in pick], quantity=quantity, unit=unit,
+                      quantities=quantities, units=file_units, t0=t0, meta=meta, source=src)
+    if any(locations.values()):
+        from ..core.record import Channel
+        rec = rec.replace(channels=tuple(Channel(c.name, c.quantity, c.unit, locations.get(c.name, ""))
+                                         for c in rec.channels))
+    return rec
+
+
+def _header_and_body(lines: list, src: str) -> tuple[dict, dict, list]:
+    """The '# key = value' header (``# channel = name; quantity; unit`` lines apart) and the data rows."""
     header_kv: dict[str, str] = {}
     chan_meta: dict[str, tuple[str, str]] = {}
     body = []
@@ -92,15 +118,20 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
                     parts = [p.strip() for p in val.split(";")]
                     if len(parts) >= 3:
                         chan_meta[parts[0]] = (parts[1], parts[2])
-                elif key == "sha256":
-                    pass
-                else:
+                elif key != "sha256":
                     header_kv[key] = val
             continue
         if s:
             body.append(ln)
     if not body:
         raise ParameterError(f"{src} has no data rows")
+    return header_kv, chan_meta, body
+
+
+def _table(body: list, src: str, max_samples) -> tuple:
+    """(values (n_rows, n_columns), column labels, whether the first row is a header): separator and
+    decimal mark sniffed, sizes checked before pandas reads anything."""
+    import pandas as pd
     sep, decimal = _sniff(body[1:] if len(body) > 1 else body)
     first = body[0].split(sep)
     if len(first) > MAX_CHANNELS:
@@ -123,12 +154,15 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
     df = df.dropna(axis=1, how="all")  # trailing separators
     if not has_header:
         df.columns = [f"ch{i}" for i in range(df.shape[1])]
-    labels = [str(c) for c in df.columns]
     for c in df.columns:
         if df[c].dtype.kind not in "fiu":
             raise ParameterError(f"{src}: column {str(c)!r} holds non-numeric values (decimal mark "
                                  f"{decimal!r}, separator {sep!r})")
-    values = df.to_numpy(dtype=np.float64)
+    return df.to_numpy(dtype=np.float64), [str(c) for c in df.columns], has_header
+
+
+def _check_rows(values, has_header: bool, header_kv: dict, src: str) -> None:
+    """Every row complete, and as many as the header states."""
     if values.shape[0] == 0:
         raise ParameterError(f"{src} has a header but no data rows")
     nan_rows = np.flatnonzero(np.isnan(values).any(axis=1))
@@ -141,12 +175,10 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
         if stated != values.shape[0]:
             raise ParameterError(f"{src}: the header states {stated:g} samples but the file holds {values.shape[0]} "
                                  "rows (a cut or edited file)")
-    names, units = [], []
-    for lab in labels:
-        nm, un = _split_name_unit(lab)
-        names.append(nm)
-        units.append(un)
-    tcol = next((i for i, n in enumerate(names) if n.lower() in _TIME_NAMES), None)
+
+
+def _timing(values, units: list, tcol, header_kv: dict, fs, src: str) -> tuple[float, float]:
+    """(fs, t0) from the header, the time column and the caller's fs; any two that disagree are an error."""
     t0 = 0.0
     stated = {k: parse_number(header_kv[k], source=src, key=f"header {k}") for k in _FS_KEYS if k in header_kv}
     if len(set(stated.values())) > 1:
@@ -169,38 +201,30 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
     fs = file_fs if file_fs is not None else require_fs(fs, source=src)
     if "t0_s" in header_kv:
         t0 = parse_number(header_kv["t0_s"], source=src, key="header t0_s")
-    data_cols = [i for i in range(len(names)) if i != tcol]
-    if not data_cols:
-        raise ParameterError(f"{src} has a time column but no data column")
-    locations = {}
-    if "channels_json" in header_kv:  # exact names (any character) written by vibmeasure
-        import json
-        try:
-            described = json.loads(header_kv["channels_json"])
-            exact = [(str(c["name"]), str(c["quantity"]), str(c["unit"]), str(c.get("location", "")))
-                     for c in described]
-        except (ValueError, TypeError, KeyError) as exc:
-            raise ParameterError(f"{src}: header channels_json is damaged ({exc})") from None
-        if len(exact) != len(data_cols):
-            raise ParameterError(f"{src}: header describes {len(exact)} channels but the file has {len(data_cols)} "
-                                 "data columns")
-        for i, (nm, q, u, loc) in zip(data_cols, exact):
-            names[i] = nm
-            chan_meta[nm] = (q, u)
-            locations[nm] = loc
-    avail = [names[i] for i in data_cols]
-    pick = [data_cols[j] for j in select_names(avail, channels, source=src)]
-    quantities = [chan_meta.get(names[i], ("unknown", ""))[0] for i in pick]
-    file_units = [chan_meta.get(names[i], (None, units[i] or ""))[1] for i in pick]
-    meta = {k: v for k, v in header_kv.items() if k not in _FS_KEYS and k not in ("t0_s", "n_samples", "channels_json")}
-    meta["source"] = str(path)
-    rec = make_record(values[:, pick].T, fs, [names[i] for i in pick], quantity=quantity, unit=unit,
-                      quantities=quantities, units=file_units, t0=t0, meta=meta, source=src)
-    if any(locations.values()):
-        from ..core.record import Channel
-        rec = rec.replace(channels=tuple(Channel(c.name, c.quantity, c.unit, locations.get(c.name, ""))
-                                         for c in rec.channels))
-    return rec
+    return fs, t0
+
+
+def _exact_channels(header_kv: dict, names: list, data_cols: list, chan_meta: dict, src: str) -> dict:
+    """Names (any character), quantities, units and locations from the header's ``channels_json``,
+    which vibmeasure writes; updates ``names`` and ``chan_meta`` and returns the locations."""
+    locations: dict = {}
+    if "channels_json" not in header_kv:
+        return locations
+    import json
+    try:
+        described = json.loads(header_kv["channels_json"])
+        exact = [(str(c["name"]), str(c["quantity"]), str(c["unit"]), str(c.get("location", "")))
+                 for c in described]
+    except (ValueError, TypeError, KeyError) as exc:
+        raise ParameterError(f"{src}: header channels_json is damaged ({exc})") from None
+    if len(exact) != len(data_cols):
+        raise ParameterError(f"{src}: header describes {len(exact)} channels but the file has {len(data_cols)} "
+                             "data columns")
+    for i, (nm, q, u, loc) in zip(data_cols, exact):
+        names[i] = nm
+        chan_meta[nm] = (q, u)
+        locations[nm] = loc
+    return locations
 
 
 def _is_number(s: str, decimal: str) -> bool:

@@ -17,93 +17,18 @@ _END = "***End_of_Header***"
 
 
 def read_lvm(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
-    import pandas as pd
     src = f"LVM file {str(path)!r}"
     try:
         text = Path(path).read_text(encoding="latin-1")
     except OSError as exc:
         raise ParameterError(f"{src} is unreadable: {exc}") from None
     lines = text.splitlines()
-    sep, dec = "\t", "."
-    header: dict[str, list[str]] = {}
-    body_start = 0
-    names: list[str] | None = None
-    if lines and lines[0].startswith("LabVIEW Measurement"):
-        ends = [i for i, ln in enumerate(lines) if ln.strip().startswith(_END)]
-        if len(ends) < 2:
-            raise ParameterError(f"{src}: LabVIEW header is incomplete (truncated file?)")
-        for ln in lines[:ends[1]]:
-            parts = ln.rstrip("\r").split("\t")
-            if parts and parts[0] and not parts[0].startswith("***"):
-                header[parts[0].strip()] = [p.strip() for p in parts[1:] if p.strip() != ""]
-        sep = {"Tab": "\t", "Comma": ",", "Semicolon": ";", "Space": " "}.get(
-            (header.get("Separator") or ["Tab"])[0], "\t")
-        dec = (header.get("Decimal_Separator") or ["."])[0]
-        if len(ends) > 2:
-            raise ParameterError(f"{src} has {len(ends) - 1} data segments; only single-segment files are read")
-        body_start = ends[1] + 1
-        while body_start < len(lines) and not lines[body_start].strip():
-            body_start += 1
-        if body_start < len(lines) and lines[body_start].startswith("X_Value"):
-            names = [p.strip() for p in lines[body_start].split(sep)]
-            body_start += 1
+    header, sep, dec, body_start, names = _lvm_header(lines, src)
     rows = [ln for ln in lines[body_start:] if ln.strip()]
-    if not rows:
-        raise ParameterError(f"{src} has no data rows")
-    check_size(len(rows) * (rows[0].count(sep) + 1), source=src, max_samples=max_samples)
-    if not text.endswith(("\n", "\r")):
-        raise ParameterError(f"{src}: the last line {rows[-1][:60]!r} has no end of line: the file was cut "
-                             "(LabVIEW ends every line)")
-    stated = [parse_number(v, source=src, key="header Samples") for v in header.get("Samples", [])]
-    if stated and any(v != len(rows) for v in stated):
-        raise ParameterError(f"{src}: the header states {int(max(stated))} samples per channel but the file holds "
-                             f"{len(rows)} rows (truncated file?)")
-    body = "\n".join(rows)
-    try:
-        df = pd.read_csv(io.StringIO(body), sep=sep, header=None, decimal=dec, engine="c")
-    except Exception as exc:
-        raise ParameterError(f"{src}: data are not readable as numbers: {exc}") from None
-    df = df.dropna(axis=1, how="all")
-    if any(df[c].dtype.kind not in "fiu" for c in df.columns):
-        raise ParameterError(f"{src}: data hold non-numeric values")
-    values = df.to_numpy(dtype=np.float64)
-    nan_rows = np.flatnonzero(np.isnan(values).any(axis=1))
-    if nan_rows.size:
-        raise ParameterError(f"{src}: data row {nan_rows[0] + 1} has missing values"
-                             f"{' (truncated file?)' if nan_rows[0] == len(values) - 1 else ''}")
+    values = _lvm_values(rows, text, header, sep, dec, src, max_samples)
     file_fs, t0, file_unit = None, 0.0, ""
     if header:
-        xcols = (header.get("X_Columns") or ["One"])[0]
-        if names:
-            names = [n for n in names if n and n != "Comment"]
-        ychan = [n for n in (names or []) if n != "X_Value"]
-        if any(("FFT" in n or "Spectrum" in n or "Power" in n) for n in ychan):
-            raise ParameterError(f"{src} holds a spectrum ({ychan[0]!r}: its X column is frequency), not a "
-                                 "time record; vm.read reads time records")
-        if "Delta_X" in header:
-            steps = {parse_number(v, source=src, key="header Delta_X") for v in header["Delta_X"]}
-            if len(steps) > 1:
-                raise ParameterError(f"{src}: the header states different Delta_X per channel {sorted(steps)}")
-            dx = steps.pop()
-            if dx <= 0:
-                raise ParameterError(f"{src}: Delta_X={dx} must be > 0")
-            file_fs = 1.0 / dx
-            t0 = parse_number((header.get("X0") or ["0"])[0], source=src, key="header X0")
-        ulab = (header.get("Y_Unit_Label") or [""])[0]
-        try:
-            file_unit = _units.normalize_unit(ulab)
-        except UnitError:
-            file_unit = ""
-        if xcols == "Multi":
-            keep = list(range(1, values.shape[1], 2))
-        elif xcols == "One":
-            keep = list(range(1, values.shape[1]))
-        else:
-            keep = list(range(values.shape[1]))
-        values = values[:, keep]
-        if not ychan or len(ychan) != values.shape[1]:
-            ychan = [f"ch{i}" for i in range(values.shape[1])]
-        names = ychan
+        values, names, file_fs, t0, file_unit = _lvm_columns(values, header, names, src)
     else:
         names = [f"ch{i}" for i in range(values.shape[1])]
     if fs is not None:
@@ -114,6 +39,102 @@ def read_lvm(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
     pick = select_names(names, channels, source=src)
     return make_record(values[:, pick].T, fs, [names[i] for i in pick], quantity=quantity, unit=unit,
                        units=[file_unit] * len(pick), t0=t0, meta={"source": str(path)}, source=src)
+
+
+def _lvm_header(lines: list, src: str):
+    """(header key -> values, separator, decimal mark, first data line, column names or None) of a
+    LabVIEW Measurement file; a file without the LabVIEW header is tab-separated numbers."""
+    sep, dec = "\t", "."
+    header: dict[str, list[str]] = {}
+    body_start = 0
+    names: list[str] | None = None
+    if not (lines and lines[0].startswith("LabVIEW Measurement")):
+        return header, sep, dec, body_start, names
+    ends = [i for i, ln in enumerate(lines) if ln.strip().startswith(_END)]
+    if len(ends) < 2:
+        raise ParameterError(f"{src}: LabVIEW header is incomplete (truncated file?)")
+    for ln in lines[:ends[1]]:
+        parts = ln.rstrip("\r").split("\t")
+        if parts and parts[0] and not parts[0].startswith("***"):
+            header[parts[0].strip()] = [p.strip() for p in parts[1:] if p.strip() != ""]
+    sep = {"Tab": "\t", "Comma": ",", "Semicolon": ";", "Space": " "}.get(
+        (header.get("Separator") or ["Tab"])[0], "\t")
+    dec = (header.get("Decimal_Separator") or ["."])[0]
+    if len(ends) > 2:
+        raise ParameterError(f"{src} has {len(ends) - 1} data segments; only single-segment files are read")
+    body_start = ends[1] + 1
+    while body_start < len(lines) and not lines[body_start].strip():
+        body_start += 1
+    if body_start < len(lines) and lines[body_start].startswith("X_Value"):
+        names = [p.strip() for p in lines[body_start].split(sep)]
+        body_start += 1
+    return header, sep, dec, body_start, names
+
+
+def _lvm_values(rows: list, text: str, header: dict, sep: str, dec: str, src: str, max_samples):
+    """The data rows as numbers, checked: size before reading, a complete last line, the header's
+    sample count, no missing value."""
+    import pandas as pd
+    if not rows:
+        raise ParameterError(f"{src} has no data rows")
+    check_size(len(rows) * (rows[0].count(sep) + 1), source=src, max_samples=max_samples)
+    if not text.endswith(("\n", "\r")):
+        raise ParameterError(f"{src}: the last line {rows[-1][:60]!r} has no end of line: the file was cut "
+                             "(LabVIEW ends every line)")
+    stated = [parse_number(v, source=src, key="header Samples") for v in header.get("Samples", [])]
+    if stated and any(v != len(rows) for v in stated):
+        raise ParameterError(f"{src}: the header states {int(max(stated))} samples per channel but the file holds "
+                             f"{len(rows)} rows (truncated file?)")
+    try:
+        df = pd.read_csv(io.StringIO("\n".join(rows)), sep=sep, header=None, decimal=dec, engine="c")
+    except Exception as exc:
+        raise ParameterError(f"{src}: data are not readable as numbers: {exc}") from None
+    df = df.dropna(axis=1, how="all")
+    if any(df[c].dtype.kind not in "fiu" for c in df.columns):
+        raise ParameterError(f"{src}: data hold non-numeric values")
+    values = df.to_numpy(dtype=np.float64)
+    nan_rows = np.flatnonzero(np.isnan(values).any(axis=1))
+    if nan_rows.size:
+        raise ParameterError(f"{src}: data row {nan_rows[0] + 1} has missing values"
+                             f"{' (truncated file?)' if nan_rows[0] == len(values) - 1 else ''}")
+    return values
+
+
+def _lvm_columns(values, header: dict, names, src: str):
+    """(values without the X columns, channel names, fs from Delta_X, t0 from X0, unit) of a file with
+    the LabVIEW header; a spectrum export is refused (vm.read_spectrum reads it)."""
+    file_fs, t0 = None, 0.0
+    xcols = (header.get("X_Columns") or ["One"])[0]
+    if names:
+        names = [n for n in names if n and n != "Comment"]
+    ychan = [n for n in (names or []) if n != "X_Value"]
+    if any(("FFT" in n or "Spectrum" in n or "Power" in n) for n in ychan):
+        raise ParameterError(f"{src} holds a spectrum ({ychan[0]!r}: its X column is frequency), not a "
+                             "time record; vm.read reads time records")
+    if "Delta_X" in header:
+        steps = {parse_number(v, source=src, key="header Delta_X") for v in header["Delta_X"]}
+        if len(steps) > 1:
+            raise ParameterError(f"{src}: the header states different Delta_X per channel {sorted(steps)}")
+        dx = steps.pop()
+        if dx <= 0:
+            raise ParameterError(f"{src}: Delta_X={dx} must be > 0")
+        file_fs = 1.0 / dx
+        t0 = parse_number((header.get("X0") or ["0"])[0], source=src, key="header X0")
+    ulab = (header.get("Y_Unit_Label") or [""])[0]
+    try:
+        file_unit = _units.normalize_unit(ulab)
+    except UnitError:
+        file_unit = ""
+    if xcols == "Multi":
+        keep = list(range(1, values.shape[1], 2))
+    elif xcols == "One":
+        keep = list(range(1, values.shape[1]))
+    else:
+        keep = list(range(values.shape[1]))
+    values = values[:, keep]
+    if not ychan or len(ychan) != values.shape[1]:
+        ychan = [f"ch{i}" for i in range(values.shape[1])]
+    return values, ychan, file_fs, t0, file_unit
 
 
 def read_lvm_spectrum(path):

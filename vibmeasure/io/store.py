@@ -403,10 +403,10 @@ class Store:
         strings) that becomes columns of :meth:`results`. The vibmeasure version is recorded."""
         self._need_writable()
         from .. import __version__
-        from ..core.results import _jsonable
+        from ..core.results import jsonable
         if not self._known(measurement):
             raise ParameterError(f"measurement={measurement!r} is not in the store")
-        row = _jsonable({"measurement": measurement, "task": _check_name(task, "task"), "version": __version__,
+        row = jsonable({"measurement": measurement, "task": _check_name(task, "task"), "version": __version__,
                          "params": params or {}, "summary": summary or {}, "result": result})
         json.dumps(row, allow_nan=True)
         self._pending["results"].append(row)

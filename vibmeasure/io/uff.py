@@ -29,7 +29,8 @@ def _check_complete(path):
                              "cut inside its last dataset")
 
 
-def _sets(path):
+def uff_sets(path):
+    """The data sets of a UFF file, read with pyuff after the file is checked complete."""
     _check_complete(path)
     try:
         import pyuff
@@ -60,7 +61,7 @@ def _unit(label, quantity):
 
 def read_uff(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
     src = f"UFF file {str(path)!r}"
-    sets = _sets(path)
+    sets = uff_sets(path)
     time_sets = [d for d in sets if int(d.get("func_type", 0)) == 1]
     if not time_sets:
         kinds = sorted({int(d.get("func_type", 0)) for d in sets})
@@ -99,7 +100,7 @@ def read_frf_uff(path):
     from ..core.results import FRF
     from ..core.results import form_of
     src = f"UFF file {str(path)!r}"
-    sets = [d for d in _sets(path) if int(d.get("func_type", 0)) == 4]
+    sets = [d for d in uff_sets(path) if int(d.get("func_type", 0)) == 4]
     if not sets:
         raise ParameterError(f"{src} holds no FRF dataset (function type 4)")
     freq = np.asarray(sets[0]["x"], float)

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core._threads import one_blas_thread
+from ..core.dispatch import analysis_for
 from ..core.errors import ParameterError, VibMeasureError
 from ..io._common import file_sha256
 
@@ -40,8 +41,9 @@ def _tasks(task) -> tuple[str, ...]:
     for t in items:
         for part in str(t).replace("+", ",").split(","):
             part = part.strip()
-            if part not in TASKS:
-                raise ParameterError(f"task={part!r} must be one of {TASKS} (or several joined by '+')")
+            if part not in TASKS + ("auto",):
+                raise ParameterError(f"task={part!r} must be one of {TASKS}, or 'auto' (each file by what it "
+                                     "holds: core.dispatch.analysis_for), or several joined by '+'")
             if part not in out:
                 out.append(part)
     if not out:
@@ -151,8 +153,10 @@ def _run(task, rec, item, options):
         return result, summary, {"nperseg": psd.params["nperseg"], "channel": psd.channels[0]}
     if task == "diagnose":
         rpm, tach = item.get("rpm"), item.get("tach")
+        rpm = rec.meta.get("rpm") if rpm is None and tach is None else rpm   # the speed the file states
         if rpm is None and tach is None:
-            raise ParameterError("task 'diagnose' needs the shaft speed: give rpm (or a tach channel) in the manifest")
+            raise ParameterError("task 'diagnose' needs the shaft speed: give rpm (or a tach channel) in the manifest, "
+                                 "or a file that states it")
         d = vm.diagnose(rec, rpm=None if rpm is None else float(rpm), bearing=item.get("bearing"), channel=ch,
                         tach=tach, pulses_per_rev=item.get("pulses_per_rev") or 1)
         rpm = d.speed.get("estimated_rpm") if rpm is None else rpm
@@ -199,6 +203,8 @@ def analyse_file(item: dict, tasks, options: dict | None = None) -> dict:
         for task in tasks:
             if task == "compare":
                 continue
+            if task == "auto":   # the file's content decides, as in the report
+                task = analysis_for(rec, rpm=item.get("rpm"), tach=item.get("tach"))
             try:
                 out["results"][task] = _run(task, rec, item, options)
             except (VibMeasureError, ValueError, ArithmeticError) as exc:

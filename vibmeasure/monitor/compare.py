@@ -41,7 +41,7 @@ def _pair(meas: ModalEstimate, pred: ModalEstimate, max_rel: float):
             cost[i, j] = abs(np.log(fm[i] / fp[j]))
     macm = None
     if meas.shapes is not None and pred.shapes is not None and np.shape(meas.shapes)[0] == np.shape(pred.shapes)[0]:
-        from ..identify.modal import mac
+        from ..identify.shapes import mac
         macm = mac(np.asarray(meas.shapes), np.asarray(pred.shapes))
         cost = cost + 0.5 * (1 - macm)
     r, c = linear_sum_assignment(cost)
@@ -65,8 +65,8 @@ class Comparison:
         return pd.DataFrame(list(self.rows))
 
     def to_dict(self) -> dict:
-        from ..core.results import _jsonable
-        return _jsonable({"verdict": self.verdict, "reason": self.reason, "modes": list(self.rows),
+        from ..core.results import jsonable
+        return jsonable({"verdict": self.verdict, "reason": self.reason, "modes": list(self.rows),
                           "unpaired_measured_hz": list(self.unpaired_measured),
                           "unpaired_predicted_hz": list(self.unpaired_predicted), "settings": self.settings})
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..core.errors import ParameterError
 
-__all__ = ["trend", "METRICS"]
+__all__ = ["trend", "metric_history", "METRICS"]
 
 K_WATCH, K_ALARM = 3.0, 6.0
 LEVELS = ("ok", "watch", "alarm")
@@ -126,3 +126,51 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
     out.attrs["points"] = {f"{a}/{p}": LEVELS[int(v)] for (a, p), v in dict(pts).items()}
     out.attrs["assets"] = {a: LEVELS[int(v)] for a, v in dict(ass).items()}
     return out.drop(columns="level")
+
+
+def metric_history(store, *, asset: str, point: str, metric: str, task: str | None = None,
+                   baseline_count: int = 8):
+    """One metric of one point over time, with its trend verdict: what ``plot_trend`` draws.
+
+    Parameters
+    ----------
+    store : str, pathlib.Path or vm.Store
+        The measurement store.
+    asset, point : str
+        The asset and its measurement point.
+    metric : str
+        A trended summary column (``METRICS``: velocity_rms_mm_s, bearing_evidence, rms, fn1_hz).
+    task : str, optional
+        The task whose results hold the metric (default: the first that has it).
+    baseline_count : int
+        Measurements in the baseline.
+
+    Returns
+    -------
+    (pandas.DataFrame, pandas.Series or None)
+        The results (``time`` and the metric among the columns) and the metric's row of
+        :func:`trend` (baseline mean and std, watch and alarm limits, verdict), None when not trended.
+
+    Raises
+    ------
+    ParameterError
+        When the metric is not trended, or the store holds no result of it for the point.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> from vibmeasure.monitor.trend import metric_history
+    >>> metric_history("missing.h5", asset="a", point="p", metric="nope")  # doctest: +SKIP
+    """
+    from ..io.store import Store
+    st = store if isinstance(store, Store) else Store(store)
+    tasks = [t for t, c, *_ in METRICS if c == metric and (task is None or t == task)]
+    if not tasks:
+        raise ParameterError(f"metric={metric!r} is not trended; one of {sorted({c for _, c, *_ in METRICS})}")
+    df = next((d for d in (st.results(t, asset=asset, point=point) for t in tasks) if not d.empty and metric in d),
+              None)
+    if df is None:
+        raise ParameterError(f"no {metric} results for {asset}/{point} in the store")
+    tr = trend(st, asset=asset, point=point, baseline_count=baseline_count)
+    row = tr[tr["metric"] == metric]
+    return df, (None if row.empty else row.iloc[0])

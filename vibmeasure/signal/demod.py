@@ -10,7 +10,7 @@ from ..core.errors import ParameterError
 from ..core.record import Channel, Record
 from ..core.results import Spectrum
 
-__all__ = ["envelope", "envelope_spectrum", "order_track", "time_synchronous_average"]
+__all__ = ["envelope", "envelope_spectrum", "order_track", "time_synchronous_average", "shaft_angle", "angle_grid", "at_times"]
 
 
 def _band(rec, band):
@@ -122,7 +122,7 @@ def _rising_edges(p, lvl, hyst):
     return cross[np.searchsorted(cross, hi_i, side="left") - 1]
 
 
-def _shaft_angle(rec, *, tach=None, rpm_profile=None, pulses_per_rev: int = 1, tach_level: float | None = None):
+def shaft_angle(rec, *, tach=None, rpm_profile=None, pulses_per_rev: int = 1, tach_level: float | None = None):
     """Shaft angle (revolutions) at every sample, from tachometer pulses or an rpm profile."""
     t = np.arange(rec.n_samples) / rec.fs
     if (tach is None) == (rpm_profile is None):
@@ -152,7 +152,7 @@ def _shaft_angle(rec, *, tach=None, rpm_profile=None, pulses_per_rev: int = 1, t
     return cumulative_trapezoid(prof / 60.0, t, initial=0.0)
 
 
-def _angle_grid(ang, fs, samples_per_rev):
+def angle_grid(ang, fs, samples_per_rev):
     """Equal steps of shaft angle (revolutions) over the samples where the angle is known, and the
     times at which the shaft reaches them."""
     ok = np.flatnonzero(np.isfinite(ang))
@@ -161,7 +161,7 @@ def _angle_grid(ang, fs, samples_per_rev):
     return grid, np.interp(grid, ang[ok], ok / fs)
 
 
-def _at_times(x, fs, t_grid):
+def at_times(x, fs, t_grid):
     """Samples x (at rate fs) interpolated at the given times (cubic spline)."""
     from scipy.interpolate import CubicSpline
     return CubicSpline(np.arange(x.size) / fs, x)(t_grid)
@@ -176,11 +176,11 @@ def order_track(rec, *, channel=None, tach=None, rpm_profile=None, samples_per_r
     i = response_channel(rec, channel)
     if isinstance(samples_per_rev, bool) or not isinstance(samples_per_rev, (int, np.integer)) or samples_per_rev < 4:
         raise ParameterError(f"samples_per_rev={samples_per_rev!r} must be an integer >= 4")
-    ang = _shaft_angle(rec, tach=tach, rpm_profile=rpm_profile, pulses_per_rev=pulses_per_rev)
-    grid, t_grid = _angle_grid(ang, rec.fs, samples_per_rev)
+    ang = shaft_angle(rec, tach=tach, rpm_profile=rpm_profile, pulses_per_rev=pulses_per_rev)
+    grid, t_grid = angle_grid(ang, rec.fs, samples_per_rev)
     if grid.size < 4 * samples_per_rev:
         raise ParameterError("fewer than 4 revolutions are covered by the speed information")
-    x = _at_times(rec.data[i], rec.fs, t_grid)
+    x = at_times(rec.data[i], rec.fs, t_grid)
     c = rec.channels[i]
     return Record(x, float(samples_per_rev), (Channel(f"{c.name}.orders", c.quantity, c.unit, c.location),),
                   meta=dict(rec.meta, domain="angle", samples_per_rev=samples_per_rev, first_rev=float(grid[0])),

@@ -19,7 +19,7 @@ from ..core._validate import as_record, clean_signal, positive, response_channel
 from ..core.errors import ParameterError
 from ..core.results import Kurtogram
 
-__all__ = ["kurtogram", "Kurtogram", "band_ses"]
+__all__ = ["kurtogram", "Kurtogram", "band_ses", "kurtogram_of", "ses_power"]
 
 _GAUSS_NEGENTROPY = 1.0 - np.euler_gamma  # E[x ln x] for x ~ Exp(1): the squared envelope of noise
 
@@ -95,7 +95,7 @@ def _spectrum_map(X: np.ndarray, n: int, fs: float, *, min_bandwidth: float, max
     return tuple(levels), tuple(nbs), tuple(kur), tuple(neg)
 
 
-def _kurtogram_of(x: np.ndarray | None, fs: float, *, min_bandwidth: float, max_level: float | None,
+def kurtogram_of(x: np.ndarray | None, fs: float, *, min_bandwidth: float, max_level: float | None,
                   criterion: str, cyclic_max: float | None, X: np.ndarray | None = None,
                   f_lo: float = 0.0, n: int | None = None, f_hi: float | None = None) -> Kurtogram:
     """The map of one signal x, or of its rfft X (record length n)."""
@@ -141,11 +141,11 @@ def kurtogram(rec, *, channel=None, min_bandwidth: float | None = None, max_leve
     if f_lo + bw > rec.fs / 2:
         raise ParameterError(f"min_frequency={f_lo:g} Hz plus min_bandwidth={bw:g} Hz exceeds the Nyquist "
                              f"frequency {rec.fs / 2:g} Hz: no band is left")
-    return _kurtogram_of(x, rec.fs, min_bandwidth=bw, max_level=max_level, criterion=criterion,
+    return kurtogram_of(x, rec.fs, min_bandwidth=bw, max_level=max_level, criterion=criterion,
                          cyclic_max=cyclic_max, f_lo=f_lo)
 
 
-def _ses_power(X: np.ndarray, n: int, fs: float, band: tuple, f_max: float) -> tuple[np.ndarray, np.ndarray, float]:
+def ses_power(X: np.ndarray, n: int, fs: float, band: tuple, f_max: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Squared-envelope spectrum of band (lo, hi) up to f_max at the record's resolution fs/n:
     (freq, amplitude of the squared envelope (unit^2), highest valid cyclic frequency)."""
     n_bins = X.size - 1
@@ -171,5 +171,5 @@ def band_ses(rec, *, band, f_max: float | None = None, channel=None, fs: float |
     x = clean_signal(rec, i, min_samples=256)
     lo, hi = check_band(band, rec.fs)
     fmax = hi - lo if f_max is None else positive(f_max, "f_max")
-    freq, amp, _ = _ses_power(_fft.rfft(x - x.mean()), x.size, rec.fs, (lo, hi), fmax)
+    freq, amp, _ = ses_power(_fft.rfft(x - x.mean()), x.size, rec.fs, (lo, hi), fmax)
     return freq, amp

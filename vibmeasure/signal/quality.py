@@ -16,7 +16,7 @@ is ``SPIKE_SIGMA`` times the residual's robust spread (MAD), ``SPIKE_LEVEL`` tim
 on each side (other comparable far-out samples there excepted, unless there are two or more: a burst).
 Two adjacent ones whose flanks are both that much lower are a two-sample glitch. Once any is found,
 an AR model of the record looks again (``_ar_spikes``) for the ones a fault's impact hides from the
-median's residual. Spikes on one grid of a fixed interval (``_grid``) are completed along it. On
+median's residual. Spikes on one grid of a fixed interval (``spike_grid``) are completed along it. On
 every channel of the 57 development recordings (CWRU at 12 kHz, MFPT at 48.8 kHz, impacts of faulty
 bearings included) no sample is found, even at 8 sigma and 3 x; the first false find is at 6 sigma
 and 3 x. Of 500 random spikes of 30 x the RMS in every 10 s of every channel of the 53 fault records
@@ -43,7 +43,7 @@ from ..core._validate import as_record
 from ..core.errors import ParameterError, warn_quality
 from ..core.record import Record
 
-__all__ = ["despike", "isolated_spikes", "fill", "flat_runs", "clipped_share", "transients", "gate"]
+__all__ = ["despike", "isolated_spikes", "fill", "flat_runs", "clipped_share", "transients", "gate", "spike_grid"]
 
 SPIKE_SIGMA = 10.0      # residual of a spike over the residual's robust spread (1.4826 MAD)
 SPIKE_ISOLATION = 4.0   # ... and over every other residual within SPIKE_CONTEXT samples
@@ -110,7 +110,7 @@ def isolated_spikes(x, *, sigma: float = SPIKE_SIGMA, isolation: float = SPIKE_I
         # the chain is seen to glitch: look again where the vibration hides a spike from the median's
         # residual (on a fault's impact ringing at 3 kHz of 12), with the AR model of the record
         found = np.union1d(found, _ar_spikes(fill(x, found), sigma))
-    grid = _grid(found)
+    grid = spike_grid(found)
     if grid is None:
         return found
     # glitches at a fixed interval (a converter's buffer): every position of the grid whose residual
@@ -201,7 +201,7 @@ def _ar_spikes(y: np.ndarray, sigma: float) -> np.ndarray:
     return np.flatnonzero(hit).astype(np.int64)
 
 
-def _grid(found: np.ndarray):
+def spike_grid(found: np.ndarray):
     """(offset, period) when the spikes found sit on one grid of a fixed period (at least GRID_MIN of
     them and GRID_SHARE of the intervals between them whole multiples of the period); else None."""
     if found.size < GRID_MIN:
@@ -366,7 +366,7 @@ def clipped_share(x) -> float:
 TRANSIENT_LEVEL = 3.0    # a window's RMS (about its own mean) over the median window's
 TRANSIENT_OFFSET = 2.0   # a window's mean off the median window mean, in median window RMS
 TRANSIENT_SHARE = 0.25   # more than this share of the record beyond either is the machine's state, not a transient
-WHITEN_TAPER = 0.05      # share of the record tapered before it is whitened (bearing_faults.TAPER)
+WHITEN_TAPER = 0.05      # share of the record tapered before it is whitened (monitor.bearing.spectra.TAPER)
 
 
 def transients(x, block: int, *, whiten: bool = False) -> list[tuple[int, int]]:
@@ -402,11 +402,11 @@ def _whitened(x: np.ndarray) -> tuple[np.ndarray, int]:
     """x cepstrally whitened (every bin of its spectrum at magnitude 1, none above the band it
     measures), after a Tukey taper of WHITEN_TAPER; and the samples at each end the taper touches."""
     from scipy.signal.windows import tukey
-    from .whiten import _cepstral_spectrum, _measured_top
+    from .whiten import cepstral_spectrum, measured_top
     n = x.size
     X = _fft.rfft((x - x.mean()) * tukey(n, WHITEN_TAPER))
-    k_hi = int(np.floor(_measured_top(X, 1.0, n) * n))
-    return _fft.irfft(_cepstral_spectrum(X, k_hi), n), int(np.ceil(WHITEN_TAPER * n / 2))
+    k_hi = int(np.floor(measured_top(X, 1.0, n) * n))
+    return _fft.irfft(cepstral_spectrum(X, k_hi), n), int(np.ceil(WHITEN_TAPER * n / 2))
 
 
 def _marked(x: np.ndarray, block: int, offset: bool) -> list[tuple[int, int]]:

@@ -16,7 +16,7 @@ from ..core._validate import as_record, clean_signal, positive, response_channel
 from ..core.errors import ParameterError
 from ..core.record import Channel, Record
 
-__all__ = ["prewhiten", "remove_synchronous"]
+__all__ = ["prewhiten", "remove_synchronous", "measured_top", "cepstral_spectrum", "edit_lines", "ar_residual", "ar_order", "synchronous_part"]
 
 _METHODS = ("cepstral", "ar")
 
@@ -25,13 +25,13 @@ def _cepstral(x: np.ndarray) -> np.ndarray:
     """Cepstral pre-whitening: the spectrum divided by its magnitude (the real cepstrum set to zero
     except at quefrency 0), so every line and resonance gets the same height and only the phase,
     which carries the impacts' timing, is left."""
-    return _fft.irfft(_cepstral_spectrum(_fft.rfft(x - x.mean())), n=x.size)
+    return _fft.irfft(cepstral_spectrum(_fft.rfft(x - x.mean())), n=x.size)
 
 
 DEAD_DB = 25.0   # a top band this far below the typical level under it holds no measurement
 
 
-def _measured_top(X: np.ndarray, fs: float, n: int) -> float:
+def measured_top(X: np.ndarray, fs: float, n: int) -> float:
     """Upper edge (Hz) of the band a record measures, from its rfft X (record length n).
 
     The spectrum is cut into 512 equal bands (each level the median of 5 neighbours, so a lone tone
@@ -56,7 +56,7 @@ def _measured_top(X: np.ndarray, fs: float, n: int) -> float:
     return fs / 2 if not dead.size else float(edges[js[dead[0]]]) * fs / n
 
 
-def _cepstral_spectrum(X: np.ndarray, k_top: int | None = None) -> np.ndarray:
+def cepstral_spectrum(X: np.ndarray, k_top: int | None = None) -> np.ndarray:
     """The spectrum of the cepstrally whitened signal (X over its magnitude), zero above bin k_top."""
     mag = np.abs(X)
     Xw = X / np.maximum(mag, 1e-12 * max(float(mag.max()), 1e-300))
@@ -65,7 +65,7 @@ def _cepstral_spectrum(X: np.ndarray, k_top: int | None = None) -> np.ndarray:
     return Xw
 
 
-def _edit_lines(x: np.ndarray, *, width: int = 33, ratio: float = 3.0) -> np.ndarray:
+def edit_lines(x: np.ndarray, *, width: int = 33, ratio: float = 3.0) -> np.ndarray:
     """Discrete lines cut to the local level of the spectrum (a frequency-domain discrete/random
     separation): every bin whose magnitude exceeds ``ratio`` x the running median of ``width`` bins
     keeps its phase and gets the median magnitude. Random (bearing) content passes unchanged."""
@@ -89,7 +89,7 @@ def _ar_coefficients(x: np.ndarray, order: int) -> np.ndarray:
     return solve_toeplitz(r[:order], r[1: order + 1])
 
 
-def _ar(x: np.ndarray, order: int) -> np.ndarray:
+def ar_residual(x: np.ndarray, order: int) -> np.ndarray:
     """Prediction error of an AR(order) model: what the signal's past cannot predict (impacts)."""
     from scipy.signal import oaconvolve
     a = _ar_coefficients(x, order)
@@ -98,13 +98,13 @@ def _ar(x: np.ndarray, order: int) -> np.ndarray:
     return e
 
 
-def _ar_order(x: np.ndarray, fs: float, f_fault: float) -> int:
+def ar_order(x: np.ndarray, fs: float, f_fault: float) -> int:
     """An AR order long enough to model the resonances but shorter than a fault period (so the
     impacts stay unpredictable): between 16 and 200 taps, a tenth of the fault period."""
     return int(np.clip(0.1 * fs / f_fault, 16, 200))
 
 
-def _synchronous_part(x: np.ndarray, fs: float, f1: float, per_rev: int | None = None) -> np.ndarray:
+def synchronous_part(x: np.ndarray, fs: float, f1: float, per_rev: int | None = None) -> np.ndarray:
     """The shaft-synchronous part at a constant speed f1: samples binned by shaft phase, averaged
     over all revolutions and interpolated back (a time-synchronous average without a tachometer)."""
     per_rev = int(per_rev or max(8, min(1024, round(fs / f1))))
@@ -141,10 +141,10 @@ def prewhiten(rec, *, method: str = "cepstral", order: int | None = None, channe
     if method == "cepstral":
         y = _cepstral(x)
     else:
-        p = _ar_order(x, rec.fs, 100.0) if order is None else order
+        p = ar_order(x, rec.fs, 100.0) if order is None else order
         if isinstance(p, bool) or not isinstance(p, (int, np.integer)) or not 1 <= p < x.size // 4:
             raise ParameterError(f"order={order!r} must be an integer from 1 to a quarter of the record ({x.size // 4})")
-        y = _ar(x, int(p))
+        y = ar_residual(x, int(p))
     c = rec.channels[i]
     return Record(y, rec.fs, (Channel(f"{c.name}.white", c.quantity, "", c.location),), t0=rec.t0, meta=rec.meta,
                   history=rec.history + (f"prewhiten(method={method!r})",))
@@ -161,6 +161,6 @@ def remove_synchronous(rec, *, shaft_hz: float, channel=None, fs: float | None =
                              "are needed to average the synchronous part")
     if f1 >= rec.fs / 4:
         raise ParameterError(f"shaft_hz={f1:g} must be below fs/4 = {rec.fs / 4:g} Hz")
-    y = x - _synchronous_part(x, rec.fs, f1)
+    y = x - synchronous_part(x, rec.fs, f1)
     return rec.replace(data=np.vstack([y if k == i else rec.data[k] for k in range(rec.n_channels)]),
                        note=f"remove_synchronous(shaft_hz={f1:g}, channel={rec.channels[i].name!r})")

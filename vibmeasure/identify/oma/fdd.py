@@ -9,12 +9,14 @@ import functools
 
 import numpy as np
 
-from ..core._threads import single_threaded
-from ..core._validate import check_band
-from ..core.errors import FitError, ParameterError, warn_quality
-from ..core.record import Record
-from ..core.results import ModalEstimate
-from .oma import MAX_REL_ZETA_STD, N_GROUPS, TONE_KURTOSIS, _check_duration, _mac, _normalise, _outputs, band_kurtosis, mpc
+from ...core._threads import single_threaded
+from ...core._validate import check_band
+from ...core.errors import FitError, ParameterError, warn_quality
+from ...core.record import Record
+from ...core.results import ModalEstimate
+from ..limits import MAX_REL_ZETA_STD
+from ..shapes import mac_pair, mpc
+from ._common import N_GROUPS, TONE_KURTOSIS, _check_duration, _normalise, _outputs, band_kurtosis
 
 __all__ = ["oma_fdd"]
 
@@ -70,7 +72,7 @@ def _fdd_peaks(f, S, U, sel, min_prom_db, df_seg, n_modes, Y, fs):
             i = idx[p]
             u = U[i, :, j]
             near = [U[k, :, j] for k in (i - 2, i + 2) if 0 <= k < U.shape[0]]
-            coh = min(_mac(u, v) for v in near) if near else 1.0
+            coh = min(mac_pair(u, v) for v in near) if near else 1.0
             cand = {"line": int(i), "sv": j, "f": float(f[i]), "prominence_db": float(prom),
                     "width_bins": float(wdt * (f[1] - f[0]) / df_seg), "coherence_mac": coh}
             kurt = band_kurtosis(Y, fs, f[i], max(0.5 * wdt * (f[1] - f[0]), 10 * fs / Y.shape[1]), u)
@@ -80,7 +82,7 @@ def _fdd_peaks(f, S, U, sel, min_prom_db, df_seg, n_modes, Y, fs):
                                                   "sinusoid gives 1.5, a mode's random response 3)"))
             elif coh < 0.9:
                 rejected.append(dict(cand, reason="singular vector not coherent around the peak (MAC < 0.9)"))
-            elif j > 0 and any(abs(c["line"] - i) <= 2 or _mac(U[c["line"], :, c["sv"]], u) >= 0.8 for c in picked):
+            elif j > 0 and any(abs(c["line"] - i) <= 2 or mac_pair(U[c["line"], :, c["sv"]], u) >= 0.8 for c in picked):
                 continue  # the second singular value's peak belongs to a mode already found
             else:
                 picked.append(cand)
@@ -166,7 +168,7 @@ def _efdd(bell, w, fs, nperseg, power=0):
 
 def _efdd_fit(bell, w, fs, nperseg):
     """Fit the bell's correlation function (a free decay) with the ring-down estimator."""
-    from .ringdown import ringdown
+    from ..ringdown import ringdown
     r = np.fft.irfft(bell)[:nperseg]
     wac = _window_autocorrelation(np.ascontiguousarray(w, float).tobytes())
     r = r / np.maximum(wac, 1e-12)
@@ -176,7 +178,8 @@ def _efdd_fit(bell, w, fs, nperseg):
     end = int(low[0]) + 4 if low.size else nperseg // 2
     end = max(min(end, int(np.argmax(wac < 0.3)) or nperseg // 2), 64)
     import warnings
-    from ..core.errors import QualityWarning
+
+    from ...core.errors import QualityWarning
     with warnings.catch_warnings():   # the ring-down's own findings stay in its flags, read by the caller
         warnings.simplefilter("ignore", QualityWarning)
         est = ringdown(Record.from_array(r[:end] / r0, fs=fs, name="correlation"), n_modes=1, start=0.0)
@@ -262,7 +265,7 @@ def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper):
     vals = []
     for g in range(Gg.shape[0]):
         Ur, Sr, _ = np.linalg.svd(tot - Gg[g, lo:hi])
-        k = int(np.argmax([_mac(Ur[c["line"] - lo, :, j], ref) for j in range(Sr.shape[1])]))
+        k = int(np.argmax([mac_pair(Ur[c["line"] - lo, :, j], ref) for j in range(Sr.shape[1])]))
         sub, sub_lines = _bell(Sr, Ur, dict(c, line=c["line"] - lo, sv=k), mac_bell)
         bell = np.zeros(Gg.shape[1])
         bell[lo:hi] = sub
@@ -349,4 +352,4 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
 
 
 def _mac_matrix(phi):
-    return np.array([[_mac(a, b) for b in phi.T] for a in phi.T])
+    return np.array([[mac_pair(a, b) for b in phi.T] for a in phi.T])

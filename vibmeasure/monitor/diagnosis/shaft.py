@@ -1,4 +1,4 @@
-"""Shaft-order faults from the velocity and acceleration spectra: unbalance, misalignment,
+"""Step: shaft-order faults from the velocity and acceleration spectra: unbalance, misalignment,
 looseness, resonance, twice line frequency (electrical) and gear mesh. Each returns table rows with
 a confidence scaled by ``level`` (0 below half the ISO zone A/B boundary, 1 from it on): a shaft-order
 fault must matter in the overall level before it is called."""
@@ -7,9 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core._validate import positive
-
-__all__ = ["shaft_order_rows", "resonance_row", "electrical_row", "gear_row"]
+from ...core._validate import positive
+from .lines import LINE_DB, _line, _row, _spectrum
 
 ORDERS = (0.5, 1, 1.5, 2, 2.5, 3, 4, 5, 6, 7, 8, 9, 10)
 # Looseness and misalignment are weighed by the share of the velocity power their own lines carry (2X
@@ -26,44 +25,44 @@ ORDERS = (0.5, 1, 1.5, 2, 2.5, 3, 4, 5, 6, 7, 8, 9, 10)
 SHAFT_SHARE = 0.2
 
 
-def _orders(f, V, f1, line):
+def _orders(f, V, f1):
     df = f[1]
     tol1 = max(2.5 * df, 0.01 * f1)
-    return {k: line(f, V, k * f1, max(tol1, 2 * df), max(0.4 * f1, 10 * df)) for k in ORDERS if k * f1 < f[-1]}
+    return {k: _line(f, V, k * f1, max(tol1, 2 * df), max(0.4 * f1, 10 * df)) for k in ORDERS if k * f1 < f[-1]}
 
 
-def shaft_order_rows(f, V, f1, v_rms, level, flags, line, row, line_db):
+def shaft_order_rows(f, V, f1, v_rms, level, flags):
     """Unbalance (1X dominates the velocity), misalignment (2X against 1X), looseness (many
     harmonics and half orders). Returns (rows, orders)."""
-    order = _orders(f, V, f1, line)
+    order = _orders(f, V, f1)
     v1 = order[1][1] if order.get(1) and order[1][1] is not None else 0.0
     v2 = order[2][1] if order.get(2) and order[2][1] is not None else 0.0
     v1_rms_mm = v1 / np.sqrt(2) * 1e3
     frac1 = (v1_rms_mm / v_rms) ** 2 if v_rms > 0 else 0.0
-    rows = [row("unbalance", f1, order[1][0], v1, order[1][2],
-                level * np.clip((frac1 - 0.5) / 0.3, 0, 1) * (v2 < 0.5 * v1) * (order[1][2] >= line_db),
+    rows = [_row("unbalance", f1, order[1][0], v1, order[1][2],
+                level * np.clip((frac1 - 0.5) / 0.3, 0, 1) * (v2 < 0.5 * v1) * (order[1][2] >= LINE_DB),
                 f"1X carries {frac1 * 100:.0f} % of the velocity power")]
     ratio = v2 / v1 if v1 > 0 else np.inf
     share2 = ((v1 ** 2 + v2 ** 2) / 2 * 1e6) / v_rms ** 2 if v_rms > 0 else 1.0   # 1X and 2X's share
-    mis = level * np.clip((ratio - 0.5) / 0.5, 0, 1) * (order[2][2] >= line_db) * min(1.0, share2 / SHAFT_SHARE)
-    rows.append(row("misalignment", 2 * f1, order[2][0], v2, order[2][2], mis,
+    mis = level * np.clip((ratio - 0.5) / 0.5, 0, 1) * (order[2][2] >= LINE_DB) * min(1.0, share2 / SHAFT_SHARE)
+    rows.append(_row("misalignment", 2 * f1, order[2][0], v2, order[2][2], mis,
                     f"2X/1X = {ratio:.2f}; 1X and 2X carry {100 * share2:.0f} % of the velocity power"))
-    harmonics = [k for k in (3, 4, 5, 6, 7, 8, 9, 10) if k in order and order[k][2] >= line_db
+    harmonics = [k for k in (3, 4, 5, 6, 7, 8, 9, 10) if k in order and order[k][2] >= LINE_DB
                  and order[k][1] > 0.1 * max(v1, 1e-300)]
-    subs = [k for k in (0.5, 1.5, 2.5) if k in order and order[k][2] >= line_db]
+    subs = [k for k in (0.5, 1.5, 2.5) if k in order and order[k][2] >= LINE_DB]
     # its lines (2X and up, the half orders) must carry the level the ISO gate weighs
-    own = harmonics + subs + ([2] if order.get(2) and order[2][2] >= line_db else [])
+    own = harmonics + subs + ([2] if order.get(2) and order[2][2] >= LINE_DB else [])
     share = sum((order[k][1] / np.sqrt(2) * 1e3) ** 2 for k in own) / v_rms ** 2 if v_rms > 0 else 1.0
     loose = np.clip((len(harmonics) - 2) / 4 + 0.35 * len(subs), 0, 1) * level * min(1.0, share / SHAFT_SHARE)
     if "speed_inconsistent" in flags:
         loose *= 0.3  # the sub-harmonics are explained by the sampling-rate contradiction
-    rows.append(row("looseness", f1, None, None, float(len(harmonics)), loose,
+    rows.append(_row("looseness", f1, None, None, float(len(harmonics)), loose,
                     f"{len(harmonics)} harmonics above 2X, sub-harmonics at {subs or 'none'}; they carry "
                     f"{100 * share:.0f} % of the velocity power"))
     return rows, order
 
 
-def resonance_row(f, V, f1, order, level, rows, row, line_db):
+def resonance_row(f, V, f1, order, level, rows):
     """The noise floor raised into a hump around a shaft order: a structural mode there (V: an
     acceleration spectrum, flat for broadband forces, with a low-sidelobe window; lines +-6 bins left
     out). An order
@@ -71,7 +70,7 @@ def resonance_row(f, V, f1, order, level, rows, row, line_db):
     df = f[1]
     res_f, res_db = None, 0.0
     for k in (1, 2, 3, 4):
-        if k not in order or order[k][2] < line_db:
+        if k not in order or order[k][2] < LINE_DB:
             continue
         fk = k * f1
         half = max(3.0, 0.1 * fk)
@@ -93,27 +92,62 @@ def resonance_row(f, V, f1, order, level, rows, row, line_db):
                                   (r["fault"] == "misalignment" and abs(res_f - 2 * f1) < 0.5 * f1)):
             r["confidence"] = float(r["confidence"] * (1 - doubt))
             r["note"] += f"; the order sits on a resonance (hump {res_db:.1f} dB)" if doubt > 0 else ""
-    return row("resonance", res_f, res_f, None, res_db, res_conf,
+    return _row("resonance", res_f, res_f, None, res_db, res_conf,
                f"noise floor raised {res_db:.1f} dB around the order at {res_f or 0:.1f} Hz (a structural mode there)")
 
 
-def electrical_row(f, A, f1, line_frequency, level, line, row, line_db):
+def electrical_row(f, A, f1, line_frequency, level):
     """Twice line frequency (stator, air gap): a 2 x line line that is not a shaft order in disguise."""
     df = f[1]
     lf = positive(line_frequency, "line_frequency")
-    fo, am, db = line(f, A, 2 * lf, max(2.5 * df, 0.002 * lf), max(5.0, 10 * df))
+    fo, am, db = _line(f, A, 2 * lf, max(2.5 * df, 0.002 * lf), max(5.0, 10 * df))
     not_order = abs(2 * lf - round(2 * lf / f1) * f1) > max(3 * df, 0.01 * f1)
-    return row("electrical", 2 * lf, fo, am, db, level * float(np.clip((db - line_db) / 12, 0, 1)) * not_order,
+    return _row("electrical", 2 * lf, fo, am, db, level * float(np.clip((db - LINE_DB) / 12, 0, 1)) * not_order,
                f"2 x line frequency ({2 * lf:g} Hz) line {db:.1f} dB")
 
 
-def gear_row(f, A, f1, gear, line, row, line_db):
+def gear_row(f, A, f1, gear):
     """Gear mesh: teeth x 1X with sidebands at +-1X."""
     df = f[1]
     fm = gear.teeth * f1
-    fo, am, db = line(f, A, fm, max(2.5 * df, 0.005 * fm), max(2 * f1, 10 * df))
-    sb = [line(f, A, fm + s * f1, max(2.5 * df, 0.005 * fm), max(f1, 10 * df))[2] for s in (-1, 1)]
-    e = max(0.0, db - line_db) / 6 + sum(0.5 * max(0.0, s - line_db) / 6 for s in sb)
-    n_sb = sum(s >= line_db for s in sb)
-    return row("gear_mesh", fm, fo, am, db, (1 - np.exp(-e / 2)) * (n_sb >= 1),
+    fo, am, db = _line(f, A, fm, max(2.5 * df, 0.005 * fm), max(2 * f1, 10 * df))
+    sb = [_line(f, A, fm + s * f1, max(2.5 * df, 0.005 * fm), max(f1, 10 * df))[2] for s in (-1, 1)]
+    e = max(0.0, db - LINE_DB) / 6 + sum(0.5 * max(0.0, s - LINE_DB) / 6 for s in sb)
+    n_sb = sum(s >= LINE_DB for s in sb)
+    return _row("gear_mesh", fm, fo, am, db, (1 - np.exp(-e / 2)) * (n_sb >= 1),
                f"mesh {gear.teeth} x 1X with sidebands at +-1X ({n_sb} found)")
+
+
+SHAFT_FAULTS = ("unbalance", "misalignment", "looseness", "resonance", "electrical", "gear_mesh")
+
+
+def shaft_rows(run, supply, gate: tuple, line_frequency) -> list:
+    """Unbalance, misalignment, looseness, resonance and (with ``line_frequency``) electrical rows, from
+    the primary channel without the supply's lines, weighed by the level (``gate``)."""
+    level, v_rms, level_all = gate
+    _, _, V = _spectrum(supply.shaft_job)
+    rows, order = shaft_order_rows(run.f, V, run.f1, v_rms, level, run.job.flags)
+    rows.append(resonance_row(run.f, _spectrum(supply.shaft_job, "blackmanharris")[1], run.f1, order, level, rows))
+    if line_frequency is not None:
+        rows.append(electrical_row(run.f, run.A, run.f1, line_frequency, level_all))
+    return rows
+
+
+def gear_rows(run) -> list:
+    """The gear-mesh row where a gear is given."""
+    return [gear_row(run.f, run.A, run.f1, run.job.gear)] if run.job.gear is not None else []
+
+
+def gate_rows(rows: list, flags: list, contradicted: bool) -> None:
+    """Rows that cannot be weighed are not called: shaft orders smear where the speed varies unfollowed,
+    and every line is looked for at a wrong frequency where the declared speed is contradicted."""
+    if "speed_varies" in flags and "order_tracked" not in flags:
+        for r in rows:
+            if r["fault"] in SHAFT_FAULTS and r["confidence"] > 0:
+                r["note"] = "not called, the speed varies over the record: " + r["note"]
+                r["confidence"] = 0.0
+    if contradicted:
+        for r in rows:
+            if r["confidence"] > 0:
+                r["note"] = "not called, the declared speed is contradicted: " + r["note"]
+            r["confidence"] = 0.0

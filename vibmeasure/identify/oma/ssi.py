@@ -1,142 +1,18 @@
-"""Output-only (operational) modal analysis: modes from the response to ambient excitation alone.
-
-``oma_ssi``: covariance-driven stochastic subspace identification. The output covariances
-R_i = E[y_{k+i} y_k^T] of a system driven by white noise are C A^(i-1) G, so the block Toeplitz
-matrix of R_1..R_(2s-1) factors into observability times controllability; its SVD gives the
-observability matrix, from which A (poles) and C (mode shapes) follow at every model order. Poles
-that persist across orders (frequency, damping and shape) are clustered into modes; each mode's
-standard deviations come from a block jackknife of the covariance estimate (the record cut into
-``n_blocks`` blocks, the identification repeated with each block left out).
-
-``oma_fdd``: frequency-domain decomposition. The SVD of the output cross-spectral matrix at every
-line separates the modes: near a mode the first singular value is that mode's SDOF bell and its
-singular vector the shape. Peaks are selected by a stated rule; EFDD takes each bell back to a
-free decay (its correlation function) and fits it with the ring-down estimator.
-"""
+"""``oma_ssi``: covariance-driven stochastic subspace identification with a stabilisation diagram,
+pole clustering and block-jackknife standard deviations."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..core._threads import single_threaded
-from ..core._validate import check_band, select_names
-from ..core.errors import FitError, ParameterError, warn_quality
-from ..core.record import Record
-from ..core.results import ModalEstimate
-
-__all__ = ["oma_ssi", "mpc", "mpd"]  # and oma_fdd, from oma_fdd.py (module __getattr__)
-
-STAB_DF = 0.01        # stable: frequency within 1 % of a pole at the previous order
-STAB_DZ = 0.05        # damping within 5 %
-STAB_MAC = 0.98       # and shape MAC >= 0.98
-CLUSTER_DF = 0.01     # poles within 1 % and
-CLUSTER_MAC = 0.9     # MAC >= 0.9 belong to one mode
-N_GROUPS = 8          # EFDD jackknife: the segments in this many groups, each left out once
-TONE_KURTOSIS = 2.2   # band kurtosis below this: a harmonic (sinusoid: 1.5), not a random response (3)
-MIN_MPC = 0.7         # modal phase collinearity below this: not a real (normal) structural mode
-MAX_ZETA = 0.2        # poles with more damping are noise or numerical
-MAX_REL_ZETA_STD = 0.3  # the limit ringdown and fit_modes use
-MIN_CYCLES = 100      # a mode needs this many cycles in the record for its damping to mean anything
-
-
-# --- shared -------------------------------------------------------------------------------------
-def mpc(phi) -> np.ndarray:
-    """Modal phase collinearity (0..1) of shapes (n_out, n_modes): 1 for a real (normal) mode."""
-    phi = np.atleast_2d(np.asarray(phi, complex).T).T
-    out = []
-    for v in phi.T:
-        sxx, syy, sxy = np.sum(v.real ** 2), np.sum(v.imag ** 2), np.sum(v.real * v.imag)
-        if sxx + syy == 0:
-            out.append(np.nan)
-            continue
-        out.append(((sxx - syy) ** 2 + 4 * sxy ** 2) / (sxx + syy) ** 2)
-    return np.array(out)
-
-
-def mpd(phi) -> np.ndarray:
-    """Mean phase deviation (degrees) of shapes (n_out, n_modes) from their best straight line in the
-    complex plane, weighted by the components' magnitudes: 0 for a real mode."""
-    phi = np.atleast_2d(np.asarray(phi, complex).T).T
-    out = []
-    for v in phi.T:
-        w = np.abs(v)
-        if not w.any():
-            out.append(np.nan)
-            continue
-        _, _, vt = np.linalg.svd(np.c_[v.real, v.imag], full_matrices=False)
-        t = vt[0]
-        den = np.abs(v) * np.hypot(*t)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            dev = np.degrees(np.arccos(np.clip(np.abs(v.real * t[0] + v.imag * t[1]) / np.maximum(den, 1e-300),
-                                               0, 1)))
-        out.append(float(np.sum(w * dev) / np.sum(w)))
-    return np.array(out)
-
-
-def _mac(a, b) -> float:
-    return float(np.abs(np.vdot(a, b)) ** 2 / max(np.vdot(a, a).real * np.vdot(b, b).real, 1e-300))
-
-
-def _normalise(phi: np.ndarray) -> np.ndarray:
-    """Scale each shape so its largest component is 1 (real when the mode is real)."""
-    phi = np.array(phi, complex)
-    for j in range(phi.shape[1]):
-        k = int(np.argmax(np.abs(phi[:, j])))
-        phi[:, j] = phi[:, j] / phi[k, j]
-    return phi
-
-
-def _outputs(rec, channels, what: str, min_outputs: int):
-    """The output channels (n_out, n) as float, checked: finite, not constant, enough of them."""
-    if not isinstance(rec, Record):
-        raise ParameterError(f"{what}: rec must be a vm.Record of the measured responses, got {type(rec).__name__}")
-    idx = select_names(rec.names, channels, source="the record")
-    if channels is None:
-        idx = [i for i in idx if rec.channels[i].quantity != "force"]
-    if len(idx) < min_outputs:
-        raise ParameterError(f"{what} needs at least {min_outputs} output channels (a mode shape needs two "
-                             f"points), got {len(idx)} ({[rec.names[i] for i in idx]}); for one channel use "
-                             "vm.oma_fdd or vm.ringdown on a free decay")
-    Y = np.asarray(rec.data[idx], float)
-    if Y.shape[1] < 16:
-        raise ParameterError(f"{what}: the record has {Y.shape[1]} samples; ambient responses need thousands")
-    bad = ~np.isfinite(Y)
-    if bad.any():
-        i, k = np.argwhere(bad)[0]
-        raise ParameterError(f"{what}: channel {rec.names[idx[i]]!r} has NaN/inf samples (first at t={k / rec.fs:g} "
-                             "s); the rule is finite data: repair or cut the record first")
-    const = [rec.names[i] for i, y in zip(idx, Y) if np.ptp(y) == 0]
-    if const:
-        raise ParameterError(f"{what}: channel(s) {const} are constant: there is no response to analyse")
-    return Y - Y.mean(axis=1, keepdims=True), [rec.names[i] for i in idx]
-
-
-def band_kurtosis(Y, fs, f0, half_width, shape=None) -> float:
-    """Kurtosis of the outputs projected on ``shape`` (default: the first output) and band-passed to
-    f0 +- half_width (FFT mask over the whole record, the ends trimmed): about 3 for a mode's random
-    response (narrow-band Gaussian), 1.5 for a harmonic (a sinusoid). Brincker's harmonic test."""
-    Y = np.atleast_2d(Y)
-    if shape is None:
-        y = Y[0]
-    else:
-        v = np.asarray(shape, complex)
-        v = v * np.exp(-1j * np.angle(np.sum(v ** 2)) / 2)   # rotate to the best real vector
-        y = np.real(v) @ Y
-    n = y.size
-    X = np.fft.rfft(y)
-    f = np.fft.rfftfreq(n, 1 / fs)
-    X[np.abs(f - f0) > half_width] = 0
-    x = np.fft.irfft(X, n)[n // 10: n - n // 10]
-    p2 = np.mean(x ** 2)
-    return float(np.mean(x ** 4) / p2 ** 2) if p2 > 0 else float("nan")
-
-
-def _check_duration(n: int, fs: float, f_lo: float, what: str):
-    need = MIN_CYCLES / f_lo
-    if n / fs < need:
-        raise ParameterError(f"{what}: the record lasts {n / fs:.4g} s; the lowest frequency of interest, "
-                             f"{f_lo:.4g} Hz, needs at least {MIN_CYCLES} cycles: a minimum duration of {need:.4g} s "
-                             f"(1000 cycles, {10 * need:.4g} s, for damping within a few %)")
+from ...core._threads import single_threaded
+from ...core._validate import check_band
+from ...core.errors import FitError, ParameterError, warn_quality
+from ...core.results import ModalEstimate
+from ..limits import MAX_REL_ZETA_STD
+from ..shapes import mac_pair, mpc, mpd
+from ._common import (CLUSTER_DF, CLUSTER_MAC, MAX_ZETA, MIN_CYCLES, MIN_MPC, STAB_DF, STAB_DZ, STAB_MAC, TONE_KURTOSIS,
+                      _check_duration, _normalise, _outputs, band_kurtosis)
 
 
 # --- SSI-cov ------------------------------------------------------------------------------------
@@ -217,7 +93,7 @@ def _stabilisation(U, sv, orders, l, fs, band):
                     st = "f"
                     if abs(zp[j] - z[k]) <= STAB_DZ * z[k]:
                         st = "d"
-                        if _mac(php[:, j], phi[:, k]) >= STAB_MAC:
+                        if mac_pair(php[:, j], phi[:, k]) >= STAB_MAC:
                             st = "s"
             table.append((n, float(f[k]), float(z[k]), st, float(m[k])))
             if st == "s" and m[k] >= MIN_MPC:
@@ -240,7 +116,7 @@ def _cluster(stable, n_orders):
         for i, p in enumerate(by_order[n]):
             for j, c in enumerate(clusters):
                 df = abs(p["f"] - c["f"]) / c["f"]
-                mac = _mac(p["phi"], c["phi"])
+                mac = mac_pair(p["phi"], c["phi"])
                 if df <= CLUSTER_DF and mac >= CLUSTER_MAC:
                     pairs.append((df + (1 - mac), i, j))
         used_p, used_c = set(), set()
@@ -298,7 +174,7 @@ def _replicate(T, V, sv, l, fs, reps):
             lam0 = rp["lam_at"][n]
             d = np.abs(lam - lam0) / abs(lam0)
             k = int(np.argmin(d))
-            if d[k] <= CLUSTER_DF and _mac(phi[:, k], rp["phi"]) >= CLUSTER_MAC:
+            if d[k] <= CLUSTER_DF and mac_pair(phi[:, k], rp["phi"]) >= CLUSTER_MAC:
                 f, z = _modal(lam[k:k + 1])
                 out[m, a] = f[0], z[0]
     return out
@@ -415,7 +291,7 @@ def oma_ssi(rec, *, band=None, max_order: int = 40, block_rows: int | None = Non
 
 
 def _screen(reps, fn_std, zeta_std, kurt):
-    """Modes whose damping the blocks reproduce (relative std <= MAX_REL_ZETA_STD, the limit of
+    """Modes whose damping the blocks reproduce (relative std <= the limit of
     ringdown and fit_modes) and whose band is a random response, not a harmonic (band kurtosis >=
     TONE_KURTOSIS); the others are listed with the reason."""
     keep, rejected = [], []
@@ -495,12 +371,3 @@ def _ssi_estimate(rec, Y, names, modes, reps, fn_std, zeta_std, table, info):
         warn_quality(f"oma_ssi: mode(s) with fewer than {MIN_CYCLES} cycles in the record: damping is poorly "
                      "determined; record longer", stacklevel=3)
     return est
-
-
-
-def __getattr__(name):
-    """oma_fdd lives in its own module (oma_fdd.py, which imports the shared checks from here)."""
-    if name == "oma_fdd":
-        from .oma_fdd import oma_fdd
-        return oma_fdd
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

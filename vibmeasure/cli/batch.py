@@ -1,0 +1,55 @@
+"""The ``batch`` command: many records analysed into a measurement store."""
+
+from __future__ import annotations
+
+from ._common import emit_json
+
+
+def register(sub) -> None:
+    """Add the command's parser to the subparsers ``sub``."""
+    bt = sub.add_parser("batch", help="analyse many records into a measurement store (serially or on Dask)",
+                        description="Analyse files, folders and globs (and/or a manifest CSV) into a vm.Store; "
+                                    "inputs already in the store are skipped.")
+    bt.add_argument("inputs", nargs="*", help="files, folders or globs")
+    bt.add_argument("--store", required=True, help="the store (.h5), created when missing")
+    bt.add_argument("--manifest", help="CSV: file, asset, point, channel, rpm, bearing, model, time")
+    bt.add_argument("--task", default="diagnose",
+                    help="ringdown, modes, spectrum, diagnose, compare, or several joined by + (default diagnose)")
+    bt.add_argument("--workers", type=int, help="local Dask cluster with this many worker processes")
+    bt.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="an existing Dask cluster's scheduler")
+    bt.add_argument("--force", action="store_true", help="analyse inputs already in the store again")
+    bt.add_argument("--keep-raw", action="store_true", help="store the raw records too")
+    bt.add_argument("--fs", type=float, help="sampling rate for files without timing")
+    bt.add_argument("--json", action="store_true", help="print one JSON document")
+
+
+def run(args, out, err) -> int:
+    """Analyse the inputs into the store (a tqdm bar on stderr), then count what was done."""
+    from tqdm import tqdm
+
+    from ..monitor.batch import batch
+    bar = None
+
+    def progress(done, total):
+        nonlocal bar
+        if bar is None:
+            bar = tqdm(total=total, unit="file", file=err, disable=None, leave=False)
+        bar.update(done - bar.n)
+    try:
+        rep = batch(args.inputs, task=args.task, store=args.store, manifest=args.manifest, workers=args.workers,
+                    scheduler=args.scheduler, force=args.force, keep_raw=args.keep_raw, fs=args.fs,
+                    progress=progress)
+    finally:
+        if bar is not None:
+            bar.close()
+    counts = rep["status"].value_counts().to_dict()
+    errors = rep[rep["status"] == "error"]
+    if args.json:
+        emit_json({"command": "batch", "store": args.store, "task": args.task, "counts": counts,
+                   "errors": errors[["file", "message"]].to_dict(orient="records")}, out, allow_nan=True)
+    else:
+        print(f"{args.store}: {counts.get('done', 0)} analysed, {counts.get('skipped', 0)} skipped (already stored), "
+              f"{counts.get('error', 0)} with errors", file=out)
+        for _, r in errors.iterrows():
+            print(f"  {r['file']}: {r['message']}", file=out)
+    return 0

@@ -1,0 +1,136 @@
+"""Line statistics: the exact law of a line over its floor, comb statistics and their Gamma tail,
+p-values to posterior confidence."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .rules import PRIOR_ODDS, R_CAP, SHAFT_PRECISION, SLIP
+from .spectra import _SES
+
+# --- statistics ---------------------------------------------------------------------------------
+
+def _log_gamma_sf(t: float, k: int) -> float:
+    """log P(Gamma(k, 1) > t), without underflow far in the tail."""
+    from scipy.special import gammaincc, gammaln
+    q = float(gammaincc(k, t)) if t > 0 else 1.0
+    if q > 1e-280:
+        return float(np.log(q))
+    # far tail: Q(k, t) ~ t^(k-1) e^-t / Gamma(k) (1 + (k-1)/t + ...)
+    return float((k - 1) * np.log(t) - t - gammaln(k) + np.log1p((k - 1) / t))
+
+
+def _log_odds(logp: np.ndarray) -> np.ndarray:
+    """Posterior log odds of a family from its p-value: the Bayes-factor bound 1 / (-e p ln p) for
+    p < 1/e (Sellke, Bayarri & Berger 2001) times the prior odds."""
+    logp = np.minimum(np.asarray(logp, float), 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_bf = np.where(logp < -1.0, -(1.0 + np.log(np.maximum(-logp, 1e-300)) + logp), 0.0)
+    return log_bf + np.log(PRIOR_ODDS)
+
+
+def _log_p_to_conf(logp: np.ndarray) -> np.ndarray:
+    """Posterior probability of each family (each against its absence) from its p-value."""
+    return 1.0 / (1.0 + np.exp(-_log_odds(logp)))
+
+
+def _positions(f0, harmonics, side, s):
+    """Line positions (n_slip, n_terms) and the (harmonic, sideband) label of each term."""
+    h = np.asarray(harmonics, float)
+    sb = (-1, 0, 1) if side else (0,)
+    terms = [(hh, k) for hh in h for k in sb]
+    H = np.array([t[0] for t in terms])
+    K = np.array([t[1] for t in terms])
+    sp = 0.0 if side is None else side[0] * (1 + s[:, None] * side[1])
+    return H * f0 * (1 + s[:, None]) + K * sp, terms
+
+
+def _best(vals: np.ndarray, n_t: int, m_eff: int, shape: float):
+    """The comb statistic of each candidate row of line values (ratios to the floor, each capped at
+    R_CAP), the best row and its log p-value: n_t terms, each with 2 bins looked at, m_eff independent
+    placements searched; ``shape``: channels averaged (Gamma(shape) per line under noise)."""
+    T = np.minimum(vals, R_CAP).sum(axis=1) + 1e-9 * vals.sum(axis=1)  # ties: the stronger lines
+    j = int(np.argmax(T))
+    return T, j, np.log(m_eff) + n_t * np.log(2.0) + _log_gamma_sf(float(T[j]) * shape, n_t * shape)
+
+
+def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
+    """Best common slip for a comb and its log p-value; None when fewer than 2 terms fit the SES."""
+    df = ses.freq[1]
+    top = (max(harmonics) * f0 + (side[0] if side else 0.0)) * (1 + slip)
+    if top / df >= ses.n_valid - 2:
+        harmonics = tuple(h for h in harmonics if (h * f0 + (side[0] if side else 0)) * (1 + slip) / df
+                          < ses.n_valid - 2)
+        if len(harmonics) < (1 if side else 2):
+            return None
+        top = (max(harmonics) * f0 + (side[0] if side else 0.0)) * (1 + slip)
+    n_s = max(3, int(np.ceil(2 * slip * top / (0.5 * df))) + 1)
+    s = np.linspace(-slip, slip, n_s)
+    pos, terms = _positions(f0, harmonics, side, s)
+    b = np.clip(pos / df, 1, ses.n_valid - 2)
+    i0 = b.astype(np.int64)
+    vals = np.maximum(ses.r[i0], ses.r[i0 + 1])
+    n_t = len(terms)
+    T, j, logp = _best(vals, n_t, int(2 * slip * top / df) + 1, ses.shape)
+    lines = [{"harmonic": float(h), "sideband": int(k), "hz": float(p), "r": float(v)}
+             for (h, k), p, v in zip(terms, pos[j], vals[j])]
+    carriers = [v for (h, k), v in zip(terms, vals[j]) if k == 0]
+    return {"logp": float(min(logp, 0.0)), "slip": float(s[j]), "stat": float(T[j]), "n_terms": n_t,
+            "edge": bool(j in (0, n_s - 1) and T[j] > T[n_s // 2]),
+            "strength": float(np.sum(carriers)),
+            "lines": lines, "n_lines": int(sum(v >= ses.r_line for v in vals[j])),
+            "n_carriers": int(sum(v >= ses.r_line for (h, k), v in zip(terms, vals[j]) if k == 0 and h <= 3)),
+            "n_odd": int(sum(v >= ses.r_line for (h, k), v in zip(terms, vals[j]) if h != int(h) or int(h) % 2)),
+            "step": _step(h for (h, k), v in zip(terms, vals[j]) if v >= ses.r_line)}
+
+
+def _step(harmonics) -> float:
+    """The spacing, in multiples of the fundamental, of the comb the standing lines' harmonics make: the
+    greatest common divisor of their half-harmonic indices 2h, over 2 (1.0 when no line stands). Up to 1
+    the lines pin the family's fundamental: harmonic 1 alone, or 1 and 2, or 2 and 3 give 1; 2 and 4
+    give 2; 3 alone gives 3. In the ball family's BSF sub-model (0.5, 1, 1.5 x 2 x BSF) 0.5 x 2 x BSF
+    alone gives 0.5, 2 x BSF alone 1 (its own lines); 1.5 x 2 x BSF alone gives 1.5."""
+    from math import gcd
+    g = 0
+    for h in harmonics:
+        g = gcd(g, int(round(2 * h)))
+    return g / 2 if g else 1.0
+
+
+def _mask(ses: _SES, hz: float):
+    """Claim the line at hz: its bins (and the leakage of a strong line) no longer count."""
+    df = ses.freq[1]
+    i = int(round(hz / df))
+    if not 2 <= i < ses.n_valid - 2:
+        return
+    lo, hi = i - 1, i + 1
+    while lo > i - 4 and ses.r[lo - 1] > 2.0:
+        lo -= 1
+    while hi < i + 4 and hi + 1 < ses.n_valid and ses.r[hi + 1] > 2.0:
+        hi += 1
+    ses.r[lo: hi + 1] = 0.0
+
+
+def _line_present(ses: _SES, hz: float) -> bool:
+    i = int(hz / ses.freq[1])
+    return 1 <= i < ses.n_valid - 2 and max(ses.r[i - 1: i + 3]) >= ses.r_line
+
+
+def _peak_at(ses: _SES, hz: float) -> float | None:
+    """The frequency of a line standing at hz: a local maximum at least R_LINE high whose interpolated
+    position lies within SHAFT_PRECISION x hz (at least 0.6 bin) of it; None when there is none, or
+    what stands there is the flank or the peak of another line beside it. On a short record a bearing
+    line a bin or two from a shaft harmonic (the 6209's BPFI is 5.977 X: 2.3 bins from 6X at 4 s)
+    would otherwise pass for the shaft's."""
+    df = ses.freq[1]
+    tol = max(0.6 * df, SHAFT_PRECISION * hz)
+    lo, hi = max(1, int(np.floor((hz - tol) / df))), min(ses.n_valid - 2, int(np.ceil((hz + tol) / df)))
+    if hi < lo:
+        return None
+    j = lo + int(np.argmax(ses.r[lo: hi + 1]))
+    a, b, c = ses.r[j - 1], ses.r[j], ses.r[j + 1]
+    if b < ses.r_line or b < a or b < c:
+        return None
+    den = a - 2 * b + c
+    f_peak = (j + (0.5 * (a - c) / den if den < 0 else 0.0)) * df
+    return f_peak if abs(f_peak - hz) <= tol else None

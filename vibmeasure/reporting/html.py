@@ -1,0 +1,113 @@
+"""Which analysis each input gets (``analyse_input``), and the self-contained page (``report``)."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import platform
+from pathlib import Path
+
+import numpy as np
+
+from ..core.dispatch import analysis_for
+from ..core.errors import ParameterError, VibMeasureError
+from ..io._common import file_sha256
+from .sections import (comparison_section, diagnosis_section, error_section, fleet_section, modes_section,
+                       ringdown_section)
+
+
+# --- analysing an input by what it holds ----------------------------------------------------------
+def analyse_input(path, *, rpm=None, bearing=None, band=None, model=None):
+    """Sections for one file, by what it holds (``core.dispatch.analysis_for``): an FRF/modes section
+    when it has a force channel, a diagnosis when a shaft speed is known (``rpm`` or the file's rpm),
+    else a ring-down; plus a comparison when a model (TOML) is given. Returns (sections, provenance row)."""
+    import warnings
+
+    from .. import io
+    from ..identify.frf import estimate_frf, impact_frf
+    from ..identify.modal import fit_modes
+    from ..identify.ringdown import ringdown
+    from ..monitor.compare import compare
+    from ..monitor.diagnosis import diagnose
+    name = Path(path).name
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rec = io.read(path)
+        forces = [c.name for c in rec.channels if c.quantity == "force"]
+        speed = rpm if rpm is not None else rec.meta.get("rpm")
+        secs, method = [], ""
+        kind = analysis_for(rec, rpm=rpm)
+        if kind == "modes":
+            try:
+                frf = impact_frf(rec, input=forces[0])
+                how = "impact_frf"
+            except VibMeasureError:
+                frf, how = estimate_frf(rec, input=forces[0]), "estimate_frf"
+            b = band or (max(1.0, 4 * float(frf.freq[1])), 0.4 * rec.fs)
+            est = fit_modes(frf, band=tuple(b))
+            secs.append(modes_section(frf, est, name))
+            method = f"{how} (input {forces[0]}) + fit_modes band {b[0]:.4g}-{b[1]:.4g} Hz"
+        elif kind == "diagnose":
+            diag = diagnose(rec, rpm=float(speed), bearing=bearing)
+            secs.append(diagnosis_section(rec, diag, name))
+            method = f"diagnose rpm {float(speed):.6g}, bearing {bearing or 'not given'}"
+            est = None
+        else:
+            est = ringdown(rec, band=band)
+            secs.append(ringdown_section(rec, est, name))
+            method = "ringdown (maximum likelihood)" + (f", band {band}" if band else "")
+        if model is not None and est is not None:
+            from ..models.loader import load
+            what = f"{name} vs {Path(model).name}"
+            try:  # a bad model is listed; the analysis of the record still stands
+                secs.append(comparison_section(compare(est, load(model)), what))
+                method += f"; compare with {Path(model).name}"
+            except (VibMeasureError, OSError, ValueError) as exc:
+                secs.append(error_section(f"comparison {what}", exc))
+    return secs, {"input": name, "sha256": file_sha256(path), "method": method}
+
+
+def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration measurement report", rpm=None,
+           bearing=None, band=None, model=None, summary=None) -> Path:
+    """Write a self-contained HTML report of ``inputs`` (files) and, with ``store``, the fleet trends;
+    returns its path. A file that cannot be analysed is listed with its error and the others are still
+    reported. Written atomically: never a half-written report."""
+    import jinja2
+    import scipy
+
+    from .. import __version__
+    from ..io._common import atomic_path
+    from ..plot import file_backend
+    out = Path(out)
+    if not out.parent.exists():
+        raise ParameterError(f"out={str(out)!r}: folder {str(out.parent)!r} does not exist")
+    if isinstance(inputs, (str, Path)):
+        inputs = [inputs]
+    file_backend()
+    sections, prov = [], []
+    for p in inputs:
+        try:
+            secs, row = analyse_input(p, rpm=rpm, bearing=bearing, band=band, model=model)
+            sections += secs
+            prov.append(row)
+        except (VibMeasureError, OSError, ValueError) as exc:
+            sections.append(error_section(Path(p).name, exc))
+            prov.append({"input": Path(p).name, "sha256": file_sha256(p) if Path(p).is_file() else "(missing)",
+                         "method": "not analysed"})
+    if store is not None:
+        try:
+            sections.append(fleet_section(store, Path(store).name if not hasattr(store, "path") else store.path.name))
+            prov.append({"input": Path(store if not hasattr(store, "path") else store.path).name,
+                         "sha256": file_sha256(store if not hasattr(store, "path") else store.path), "method": "trend"})
+        except (VibMeasureError, OSError, ValueError) as exc:
+            sections.append(error_section(str(store), exc))
+    if not sections:
+        raise ParameterError("nothing to report: give input files and/or a store")
+    env = jinja2.Environment(loader=jinja2.PackageLoader("vibmeasure.reporting", "templates"),
+                             autoescape=jinja2.select_autoescape(["html", "j2"]))
+    html = env.get_template("report.html.j2").render(
+        title=title, version=__version__, created=_dt.datetime.now().strftime("%Y-%m-%d %H:%M"),
+        sections=sections, provenance=prov, summary=summary or [], python=platform.python_version(),
+        numpy=np.__version__, scipy=scipy.__version__)
+    with atomic_path(out) as tmp:
+        tmp.write_text(html, encoding="utf-8")
+    return out
