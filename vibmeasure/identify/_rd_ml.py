@@ -209,11 +209,45 @@ def ringdown_crb(*, fn: float, zeta: float, fs: float, duration: float, amplitud
                  phase: float = 0.0, noise_std: float | None = None, snr_db: float | None = None) -> dict:
     """Cramer-Rao bound on fn and zeta for one damped sinusoid in white Gaussian noise.
 
-    The signal is ``amplitude * exp(-zeta wn t) cos(wd t + phase)`` sampled at ``fs`` for
-    ``duration`` s; the noise std is given, or follows from ``snr_db`` = 10 log10(A^2 / (2 s^2)).
-    The bound is the inverse Fisher information of (sigma, wd, a, b), mapped to fn and zeta.
-    Use it to plan a test: the std any unbiased estimator can reach.
-    Returns dict with fn_std, zeta_std (and fn, zeta).
+    The signal is ``amplitude * exp(-zeta wn t) cos(wd t + phase)`` sampled at ``fs`` for ``duration``
+    s. The bound is the inverse Fisher information of (sigma, wd, a, b), mapped to fn and zeta: the std
+    any unbiased estimator can reach. Use it to plan a test.
+
+    Parameters
+    ----------
+    fn : float
+        Natural frequency in Hz.
+    zeta : float
+        Damping ratio.
+    fs : float
+        Sampling rate in Hz.
+    duration : float
+        Record length in s.
+    amplitude : float
+        Initial amplitude.
+    phase : float
+        Initial phase in radians.
+    noise_std : float, optional
+        Noise standard deviation (give it or ``snr_db``).
+    snr_db : float, optional
+        10 log10(A^2 / (2 s^2)).
+
+    Returns
+    -------
+    dict
+        fn_std, zeta_std (and fn, zeta).
+
+    Raises
+    ------
+    ParameterError
+        Without noise_std or snr_db, or for values out of range.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> crb = vm.ringdown_crb(fn=10.37, zeta=0.02, fs=1000.0, duration=10.0, snr_db=40)
+    >>> bool(crb["zeta_std"] < 1e-3)
+    True
     """
     from ..core._validate import positive
     fn, fs, duration = positive(fn, "fn"), positive(fs, "fs"), positive(duration, "duration")

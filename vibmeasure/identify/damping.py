@@ -23,7 +23,28 @@ MIN_SIGMA_T = 4.0       # half-power: the record must capture the decay (sigma *
 
 
 def zeta_from_delta(delta):
-    """Exact damping ratio from the logarithmic decrement: zeta = delta / sqrt(4 pi^2 + delta^2)."""
+    """Exact damping ratio from the logarithmic decrement: zeta = delta / sqrt(4 pi^2 + delta^2).
+
+    Parameters
+    ----------
+    delta : float or array_like
+        Logarithmic decrement ln(A_i / A_{i+1}).
+
+    Returns
+    -------
+    float or numpy.ndarray
+
+    Raises
+    ------
+    ParameterError
+        For a negative or non-finite decrement.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> round(float(vm.zeta_from_delta(0.1257)), 4)
+    0.02
+    """
     delta = np.asarray(delta, dtype=float)
     return delta / np.sqrt(4 * np.pi ** 2 + delta ** 2)
 
@@ -133,12 +154,44 @@ def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: 
                   fs: float | None = None) -> ModalEstimate:
     """Damping from the logarithmic decrement of successive cycle amplitudes.
 
-    Each half-cycle extreme is refined by local least squares (a parabola over +-0.1 period) and
-    paired with the next extreme of opposite sign, so offsets and drift cancel. Peaks below
-    10x the noise std are excluded. With ``n=None`` the decrement is the slope of a weighted
-    regression of ln(amplitude) over all usable cycles (weights amplitude^2, the inverse
-    variance of ln A); with ``n`` it is the mean of ln(A_i / A_{i+n}) / n over cycles n apart.
-    zeta = delta / sqrt(4 pi^2 + delta^2) (exact). ``band`` band-passes first (one mode).
+    Each half-cycle extreme is refined by a local parabola and paired with the next extreme of opposite
+    sign, so offsets and drift cancel; peaks below 10 x the noise std are left out. Without ``n`` the
+    decrement is the slope of a weighted regression of ln(amplitude) over all usable cycles; with ``n``
+    the mean of ln(A_i / A_{i+n}) / n. zeta = delta / sqrt(4 pi^2 + delta^2) (exact).
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The ring-down.
+    channel : str or int, optional
+        The response channel.
+    n : int, optional
+        Cycles between the amplitudes compared.
+    band : tuple of float, optional
+        (lo, hi) Hz band-pass first (one mode).
+    start : float, optional
+        Time (s) where the free decay begins.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    ModalEstimate
+        One mode, with its std.
+
+    Raises
+    ------
+    ParameterError
+        For bad input.
+    FitError
+        For too few cycles above the noise.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.free_decay(fn=10.0, zeta=0.02, fs=1000.0, duration=10.0, snr_db=60, seed=1)
+    >>> round(float(vm.log_decrement(rec).zeta[0]), 3)
+    0.02
     """
     if n is not None and (isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1):
         raise ParameterError(f"n={n!r} must be None (regression) or an integer >= 1 (cycles apart)")
@@ -224,11 +277,41 @@ def hilbert_decay(rec, *, channel=None, band=None, start: float | None = None,
                   fs: float | None = None) -> ModalEstimate:
     """Damping from the Hilbert envelope of the band-passed decay.
 
-    The mode is band-passed into its analytic signal by complex demodulation (zero-phase
-    Butterworth; default band +-30 % around the strongest spectral line, wider for a heavily
-    damped mode), the log-envelope is fitted by weighted least squares
-    where it lies at least 20 dB above the in-band noise, skipping the filter's end effects,
-    and the damped frequency comes from the slope of the unwrapped phase.
+    The mode is band-passed into its analytic signal (zero-phase Butterworth; default +-30 % around the
+    strongest line), the log-envelope fitted by weighted least squares where it stands 20 dB above the
+    in-band noise, and the damped frequency taken from the unwrapped phase's slope.
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The ring-down.
+    channel : str or int, optional
+        The response channel.
+    band : tuple of float, optional
+        (lo, hi) Hz of the band-pass.
+    start : float, optional
+        Time (s) where the free decay begins.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    ModalEstimate
+        One mode, with its std.
+
+    Raises
+    ------
+    ParameterError
+        For bad input.
+    FitError
+        For too short a decay above the noise.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.free_decay(fn=10.0, zeta=0.02, fs=1000.0, duration=10.0, snr_db=60, seed=1)
+    >>> round(float(vm.hilbert_decay(rec).zeta[0]), 3)
+    0.02
     """
     rec, idx, x, _, flags, i0, _ = _prepare(rec, channel, None, start, fs, trim=True, work=10)
     fsr = rec.fs
@@ -325,14 +408,45 @@ def _envelope_fit(tt, env, pp, fs, bw):
 
 @memory_guard
 def half_power(obj, *, band=None, channel=None, start: float | None = None, fs: float | None = None) -> ModalEstimate:
-    """Half-power bandwidth: of an FRF or spectrum peak (exact relations per form, see
-    ``half_power_frf``), or of the ring-down spectrum of a Record.
+    """Half-power bandwidth of an FRF or spectrum peak, or of a ring-down's spectrum.
 
-    The decay's power spectrum (zero-padded 16x, no window: the decay itself ends the record)
-    is a Lorentzian about the damped frequency whose half-power points lie at wd +- sigma, so
-    zeta = sigma / sqrt(wd^2 + sigma^2) with sigma = pi (f2 - f1); crossings are interpolated.
-    Refused (FitError) when the record stops before the decay is over (sigma * T < 4), which
-    widens the peak. The method gives no statistical std (NaN).
+    On an FRF or spectrum the exact relations per form apply (``half_power_frf``). On a ring-down the
+    decay's power spectrum (zero-padded 16 x, no window) is a Lorentzian whose half-power points lie at
+    wd +- sigma, so zeta = sigma / sqrt(wd^2 + sigma^2); refused when the record stops before the decay
+    is over (sigma T < 4). The method gives no statistical std (NaN).
+
+    Parameters
+    ----------
+    obj : FRF, Spectrum, Record or array_like
+        What to measure.
+    band : tuple of float, optional
+        (lo, hi) Hz where the peak is searched.
+    channel : str or int, optional
+        The channel (the FRF's output).
+    start : float, optional
+        Time (s) where a free decay begins.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    ModalEstimate
+        One mode; ``extras`` holds f1_hz, f2_hz and the lines across the band.
+
+    Raises
+    ------
+    ParameterError
+        For bad input.
+    FitError
+        When the bandwidth spans fewer than 3 lines, or the decay outlasts the record.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> h = vm.synth.modal_frf(np.linspace(1, 100, 4000), fn=[30.0], zeta=[0.02], shapes=[[1.0]], form="mobility")
+    >>> round(float(vm.half_power(h).zeta[0]), 3)
+    0.02
     """
     from ..core.record import Record
     if isinstance(obj, (FRF, Spectrum)):

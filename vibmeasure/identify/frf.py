@@ -126,10 +126,49 @@ def estimate_frf(rec, *, input="force", outputs=None, estimator: str = "H1", npe
                  progress=None) -> FRF:
     """FRFs from input (force) and output records by segment averaging.
 
-    ``estimator``: "H1" (noise on the output; MIMO by Gyx Gxx^-1), "H2" (noise on the input) or
-    "Hv" (equal noise on both; single input). Returns an :class:`FRF` whose form follows the
-    output quantity, with ordinary (one input) or multiple coherence and the normalised random
-    error of |H| = sqrt(1 - coh) / (sqrt(coh) sqrt(2 n_avg)). At least 2 averages are required.
+    Parameters
+    ----------
+    rec : Record
+        Force and responses.
+    input : str, int or list
+        The input (force) channel(s); "force" takes the channel whose quantity is force.
+    outputs : str, int or list, optional
+        Output channels (default every other channel).
+    estimator : {"H1", "H2", "Hv"}
+        H1 (noise on the output; MIMO by Gyx Gxx^-1), H2 (noise on the input) or Hv (both; one input).
+    nperseg, noverlap : int, optional
+        Segment length and overlap.
+    window : str, tuple or array_like
+        Window.
+    detrend : {"constant", "linear", False}
+        What each segment loses first.
+    fs : float, optional
+        Sampling rate for an array.
+    progress : callable, optional
+        ``progress(fraction)`` as blocks finish.
+
+    Returns
+    -------
+    FRF
+        Form from the output quantity, with ordinary (one input) or multiple coherence and the
+        normalised random error sqrt(1 - coh) / (sqrt(coh) sqrt(2 n_avg)).
+
+    Raises
+    ------
+    ParameterError
+        For unknown channels, bad parameters or fewer than 2 averages.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> f = np.random.default_rng(1).normal(size=16384)
+    >>> x = vm.synth.modal_response(f, fs=1024.0, fn=[50.0], zeta=[0.02], shapes=[[1.0]])
+    >>> rec = vm.Record(np.vstack([f, x]), fs=1024.0, channels=[vm.Channel("force", "force", "N"),
+    ...                                                          vm.Channel("x", "displacement", "m")])
+    >>> frf = vm.estimate_frf(rec, nperseg=2048)
+    >>> frf.form
+    'receptance'
     """
     rec = as_record(rec, fs=fs)
     if estimator not in ("H1", "H2", "Hv"):
@@ -174,8 +213,38 @@ MAX_BUSY = 0.05   # an impact record's force is near zero except in its pulses: 
 
 
 def find_hits(force, fs: float, *, threshold: float = 0.1, min_gap_s: float | None = None) -> np.ndarray:
-    """Sample indices where hammer hits start: rising crossings of threshold x the largest peak,
-    at least ``min_gap_s`` apart (default 0.1 s)."""
+    """Sample indices where hammer hits start: rising crossings of ``threshold`` x the largest peak.
+
+    Parameters
+    ----------
+    force : array_like
+        The force samples.
+    fs : float
+        Sampling rate in Hz.
+    threshold : float
+        Share of the largest peak a hit must cross.
+    min_gap_s : float, optional
+        Least time between two hits (default 0.1 s).
+
+    Returns
+    -------
+    numpy.ndarray
+        Start indices.
+
+    Raises
+    ------
+    ParameterError
+        For a constant or non-finite force.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> f = np.zeros(3000)
+    >>> f[[500, 2000]] = 100.0
+    >>> vm.find_hits(f, 1000.0).tolist()
+    [500, 2000]
+    """
     f = np.asarray(force, float)
     if not np.isfinite(f).all():
         raise ParameterError("the force channel has NaN/inf samples")
@@ -209,13 +278,49 @@ def impact_frf(rec, *, input="force", outputs=None, record_length: float | None 
                threshold: float = 0.1, fs: float | None = None) -> FRF:
     """FRFs from a hammer test: one record per hit, averaged (H1 by default).
 
-    Each hit starts ``pretrigger`` s before the force crosses ``threshold`` of its peak and lasts
-    ``record_length`` s (default: up to the next hit, at most the shortest spacing). The force
-    window keeps the pulse (zero beyond twice its duration); the exponential window exp(-t/tau)
-    (``"auto"``: 1 % at the record end, a number: tau in s, None: off) is applied to force and
-    response, so each pole moves left by exactly 1/tau; the FRF carries tau and fit_modes removes
-    it. Double hits (a second pulse above 20 % after the first ended) and clipping are flagged
-    (params["flags"], QualityWarning); clean single hits are not.
+    Each hit starts ``pretrigger`` s before the force crosses ``threshold`` of its peak. The force
+    window keeps the pulse (zero beyond twice its duration); the exponential window exp(-t/tau) is
+    applied to force and response, so each pole moves left by exactly 1/tau; the FRF carries tau and
+    fit_modes removes it. Double hits and clipping are flagged (params["flags"], QualityWarning).
+
+    Parameters
+    ----------
+    rec : Record
+        Force and responses of all hits.
+    input : str or int
+        The force channel ("force": the channel whose quantity is force).
+    outputs : str, int or list, optional
+        Output channels (default every other channel).
+    record_length : float, optional
+        Seconds per hit (default up to the next hit, at most the shortest spacing).
+    pretrigger : float
+        Seconds kept before the trigger.
+    exp_window : "auto", float or None
+        "auto": 1 % at the record end; a number: tau in s; None: off.
+    force_window : bool
+        Zero the force beyond twice the pulse's duration.
+    estimator : {"H1", "H2", "Hv"}
+        As in ``estimate_frf``.
+    threshold : float
+        Share of the largest force peak a hit must cross.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    FRF
+
+    Raises
+    ------
+    ParameterError
+        For no hit, unknown channels or a record too short for one hit.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> hammer = vm.synth.hammer_test(fn=[21.3, 57.9], zeta=[0.01, 0.02], shapes=[[1.0, 0.5]], fs=1024.0, seed=1)
+    >>> vm.impact_frf(hammer, input="hammer").params["n_averages"]
+    3
     """
     rec = as_record(rec, fs=fs)
     ii, oo = _io(rec, input, outputs)

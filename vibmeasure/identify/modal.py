@@ -63,25 +63,52 @@ def _band_lines(frf: FRF, band, inp):
 
 @single_threaded
 def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None, input=0) -> ModalEstimate:
-    """Natural frequencies, damping ratios and mode shapes from FRFs in ``band`` (Hz).
+    """Natural frequencies, damping ratios and mode shapes from FRFs in a band.
 
-    LSCF poles for orders 2..max_order build an automatic stabilisation diagram; poles stable in
-    frequency (1 %) and damping (5 %) are clustered across orders and the clusters seen at enough
-    orders are the modes (or the ``n_modes`` most persistent). Poles, complex residues and residual
-    terms (1/(iw)^2, constant, iw per output) are then fitted by weighted nonlinear least squares
-    (maximum likelihood for complex Gaussian noise, each output weighted by its residual noise),
-    giving fn, zeta and their standard deviations from the Fisher information. An exponential
-    window from vm.impact_frf is removed exactly (sigma - 1/tau). ``extras`` holds poles,
-    residues, the stabilisation table, the synthesised FRFs' correlation (FRAC) and the mode shapes
-    are in ``shapes`` (n_outputs, n_modes), unit-normalised (mass-normalised when an output is the
-    driving point).
+    LSCF poles for orders 2..``max_order`` build an automatic stabilisation diagram; poles stable in
+    frequency (1 %) and damping (5 %) are clustered across orders. Poles, complex residues and residual
+    terms are then fitted by weighted nonlinear least squares (maximum likelihood for complex Gaussian
+    noise, each output weighted by its residual noise), with stds from the Fisher information. A mode
+    is reported only where the data support it (Wald test of its residues at a 1 % false-alarm rate
+    per fit, zeta known to 30 %); the refused poles are in ``extras["rejected_modes"]``. An exponential
+    window from ``impact_frf`` is removed exactly. ``input="all"`` fits every input column at once
+    (poly-reference: one set of poles).
 
-    Poly-reference: ``input="all"`` (or a list of inputs) fits the FRFs of every input column at
-    once, so a MIMO test gives one set of poles; each (output, input) FRF is a row of one common-
-    denominator model (``extras["rows"]``). Each mode's shape comes from the input that excites it
-    most (``extras["reference_input"]``); ``extras["participation"]`` (n_inputs, n_modes) is each
-    input's share. A common denominator does not separate a repeated root (two modes at one
-    frequency); modes a few half-power bandwidths apart are separated.
+    Parameters
+    ----------
+    frf : FRF
+        The FRFs.
+    band : tuple of float
+        (lo, hi) Hz.
+    max_order : int
+        Highest LSCF model order.
+    n_modes : int, optional
+        Keep the n most persistent clusters (default: every supported mode).
+    input : int, str, list or "all"
+        The input column(s).
+
+    Returns
+    -------
+    ModalEstimate
+        fn, zeta, their stds, ``shapes`` (n_outputs, n_modes) and ``extras`` (poles, residues, the
+        stabilisation table, FRAC).
+
+    Raises
+    ------
+    ParameterError
+        For a band outside the FRF or an unknown input.
+    FitError
+        When no mode is left (the candidates are named).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> freq = np.linspace(1, 100, 1000)
+    >>> h = vm.synth.modal_frf(freq, fn=[30.0], zeta=[0.02], shapes=[[1.0]])
+    >>> est = vm.fit_modes(h, band=(10, 60))
+    >>> round(float(est.fn[0]), 3), round(float(est.zeta[0]), 4)
+    (30.0, 0.02)
     """
     f, H, ii, band = _band_lines(frf, band, input)
     _check_orders(max_order, n_modes)
@@ -280,11 +307,39 @@ def _fit_extras(frf, f, H, ii, band, m: _Poles, coef, sw, keep, table, n_orders,
 
 
 def synthesize_frf(est: ModalEstimate, freq, *, residuals: bool = False) -> np.ndarray:
-    """FRFs (n_rows, n_freq) synthesised from a fit_modes estimate's poles and residues: the modal
-    part only, or with ``residuals=True`` the whole fitted model: also the residual terms (lower
-    1/(iw)^2, constant, upper iw) and the poles fitted but not reported (outside the band), which
-    stand for the modes outside the band; the rows are the outputs (times inputs for a
-    poly-reference fit, in ``extras["rows"]`` order)."""
+    """FRFs synthesised from a fit_modes estimate's poles and residues.
+
+    Parameters
+    ----------
+    est : ModalEstimate
+        A ``fit_modes`` estimate.
+    freq : array_like
+        Frequency lines in Hz.
+    residuals : bool
+        Also the residual terms (lower 1/(iw)^2, constant, upper iw) and the poles fitted but not
+        reported: the whole fitted model.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_rows, n_freq) complex; rows are the outputs (times inputs for a poly-reference fit, in
+        ``extras["rows"]`` order).
+
+    Raises
+    ------
+    ParameterError
+        For an estimate without residual terms when ``residuals=True``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> freq = np.linspace(1, 100, 1000)
+    >>> h = vm.synth.modal_frf(freq, fn=[30.0], zeta=[0.02], shapes=[[1.0]])
+    >>> est = vm.fit_modes(h, band=(10, 60))
+    >>> vm.synthesize_frf(est, freq).shape
+    (1, 1000)
+    """
     if "poles" not in est.extras or "residues" not in est.extras:
         raise ParameterError("est must come from vm.fit_modes (it needs poles and residues)")
     try:
@@ -314,9 +369,40 @@ def synthesize_frf(est: ModalEstimate, freq, *, residuals: bool = False) -> np.n
 
 
 def modal_crb(freq, *, fn, zeta, residues, noise_std) -> dict:
-    """Cramer-Rao bound on fn and zeta for FRFs in complex Gaussian noise (std noise_std per output,
-    E|n|^2 = s^2), from the Fisher information of the modal model with complex residues (the same
-    parameters fit_modes estimates, residual terms included). Returns fn_std, zeta_std arrays."""
+    """Cramer-Rao bound on fn and zeta for FRFs in complex Gaussian noise.
+
+    From the Fisher information of the modal model with complex residues (the parameters fit_modes
+    estimates, residual terms included); the noise has E|n|^2 = s^2 per output.
+
+    Parameters
+    ----------
+    freq : array_like
+        Frequency lines in Hz.
+    fn, zeta : array_like
+        The modes.
+    residues : array_like
+        Complex residues (n_outputs, n_modes).
+    noise_std : array_like
+        One noise std per output.
+
+    Returns
+    -------
+    dict
+        fn_std, zeta_std arrays.
+
+    Raises
+    ------
+    ParameterError
+        For shapes that do not match or a noise std that is not positive.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> b = vm.modal_crb(np.linspace(1, 100, 1000), fn=[30.0], zeta=[0.02], residues=[[1.0]], noise_std=[1e-3])
+    >>> bool(b["zeta_std"][0] < 1e-3)
+    True
+    """
     f = np.asarray(freq, float)
     f = f[f > 0]
     w = 2 * np.pi * f
@@ -365,13 +451,39 @@ def _circle_angles_fit(w, ang, wn0, zeta0, a0):
 
 
 def circle_fit(frf: FRF, *, band, output=0, input=0) -> ModalEstimate:
-    """SDOF circle fit (Kennedy-Pancu) on the mobility around one peak in ``band``.
+    """SDOF circle fit (Kennedy-Pancu) on the mobility around one peak.
 
-    The mobility of a viscously damped mode traces a circle on which the angle from the resonance
-    point obeys tan(theta / 2) = (w^2 - wn^2) / (2 zeta wn w) exactly. Start values: fn where the
-    angle sweeps fastest and the median zeta of point pairs; then fn, zeta and the resonance angle
-    by least squares on all points, with standard deviations from the residual scale (exact on exact
-    data; zero std there).
+    The mobility of a viscously damped mode traces a circle on which the angle from the resonance point
+    obeys tan(theta / 2) = (w^2 - wn^2) / (2 zeta wn w) exactly; fn, zeta and the resonance angle are
+    fitted by least squares on all points, with stds from the residual scale.
+
+    Parameters
+    ----------
+    frf : FRF
+        The FRFs.
+    band : tuple of float
+        (lo, hi) Hz around one peak.
+    output, input : int or str
+        The FRF row and column.
+
+    Returns
+    -------
+    ModalEstimate
+        One mode.
+
+    Raises
+    ------
+    ParameterError
+        For a band with too few lines or unknown channels.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> freq = np.linspace(1, 100, 2000)
+    >>> h = vm.synth.modal_frf(freq, fn=[30.0], zeta=[0.02], shapes=[[1.0]])
+    >>> round(float(vm.circle_fit(h, band=(27, 33)).zeta[0]), 4)
+    0.02
     """
     if not isinstance(frf, FRF):
         raise ParameterError(f"frf must be a vm.FRF, got {type(frf).__name__}")

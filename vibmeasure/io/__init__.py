@@ -33,17 +33,50 @@ def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, qua
 
     The format follows the ending: .csv/.txt/.tsv, .h5/.hdf5, .wav, .mat (v5 and v7.3), .lvm, .uff/.unv;
     a file whose ending names none of them (the IMS rig's 2004.02.12.10.32.39) is recognised by its
-    content (signature, or lines of delimited numbers).
-    ``fs`` is required when the file holds no timing information and must agree with it
-    otherwise. ``channels`` selects columns/variables by name (dotted paths for MATLAB structs,
-    ``"name[i]"`` for one row of a matrix) or position; ``quantity`` and ``unit`` label the data
-    when the file does not. ``dataset`` names a bare dataset in a foreign HDF5 file.
+    content (signature, or lines of delimited numbers). A damaged, truncated or contradictory file
+    raises ParameterError naming the file and the rule (a CSV whose last line has no end of line drops
+    that line with a QualityWarning); NaN, inf and complex data are refused.
 
-    Guarantees: a damaged, truncated or contradictory file raises ParameterError naming the file and
-    the rule (or, for a CSV whose last line has no end of line, drops that line with a QualityWarning);
-    a file declaring more than ``max_samples`` values is refused before anything is allocated; NaN,
-    inf and complex data are refused; HDF5 external storage and links that leave the file are refused
-    unless ``allow_external=True``.
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    fs : float, optional
+        Sampling rate in Hz: required when the file holds no timing, and must agree with it otherwise.
+    channels : str, int or list, optional
+        Columns or variables to read, by name (dotted paths for MATLAB structs, ``"name[i]"`` for one row
+        of a matrix) or position; default all.
+    quantity : str, optional
+        "displacement", "velocity", "acceleration" or "force" when the file does not say.
+    unit : str, optional
+        The data's unit when the file does not say ("g", "m/s^2", "mm/s", "N", ...).
+    dataset : str, optional
+        A bare dataset in a foreign HDF5 file.
+    max_samples : int
+        Files declaring more values are refused before anything is allocated.
+    allow_external : bool
+        Accept HDF5 external storage and links that leave the file (refused by default: they can read
+        any local file as samples).
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For a missing, damaged, truncated, contradictory or oversized file, or a missing ``fs``.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.read("sample_data/ringdown_beam.csv")  # doctest: +SKIP
+    >>> rec = vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=2.0)
+    >>> import tempfile, pathlib
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "decay.csv"
+    >>> _ = vm.write(path, rec)
+    >>> vm.read(path).fs
+    500.0
     """
     p = Path(path)
     if not p.exists():
@@ -117,7 +150,35 @@ def guarded(reader, path, kind=None, **kw):
 
 
 def write(path: str | os.PathLike, obj) -> Path:
-    """Write a :class:`Record` to .csv, .h5/.hdf5 or .wav, atomically (never half-written)."""
+    """Write a :class:`Record` to .csv, .h5/.hdf5 or .wav, atomically (never half-written).
+
+    The file carries a SHA-256 of its content, so a later change of any byte is found when it is read.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file; its ending chooses the format.
+    obj : Record
+        The record.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown ending, a folder that does not exist, or a folder, FIFO or device at the path.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=1.0)
+    >>> vm.write(pathlib.Path(tempfile.mkdtemp()) / "decay.h5", rec).suffix
+    '.h5'
+    """
     if not isinstance(path, (str, os.PathLike)):
         hint = " (the order is vm.write(path, record))" if isinstance(obj, (str, os.PathLike)) else ""
         raise ParameterError(f"path must be a file name, got {type(path).__name__}{hint}")
@@ -132,9 +193,34 @@ def write(path: str | os.PathLike, obj) -> Path:
 
 
 def read_frf(path: str | os.PathLike, *, variable: str | None = None, fs: float | None = None):
-    """Read frequency response functions: UFF dataset 58 function type 4 (.uff/.unv), or a MATLAB
-    variable holding a complex FRF with its frequency vector (``variable``, e.g. "Hf_chan_2";
-    the frequency axis from a "Freq_domain"-like vector or from ``fs`` and the line count)."""
+    """Read frequency response functions from a file.
+
+    UFF dataset 58 function type 4 (.uff/.unv), or a MATLAB variable holding a complex FRF with its
+    frequency vector (the axis from a "Freq_domain"-like vector, or from ``fs`` and the line count).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    variable : str, optional
+        The MATLAB variable holding the complex FRF (e.g. "Hf_chan_2").
+    fs : float, optional
+        Sampling rate in Hz, when a MATLAB file holds no frequency vector.
+
+    Returns
+    -------
+    FRF
+
+    Raises
+    ------
+    ParameterError
+        For a file without FRFs, a damaged file or a missing frequency axis.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> frf = vm.read_frf("../shared/data/impact/case1.mat", variable="Hf_chan_2")  # doctest: +SKIP
+    """
     from ..core.results import FRF
     p = Path(path)
     if not p.exists():
@@ -164,8 +250,30 @@ def read_frf(path: str | os.PathLike, *, variable: str | None = None, fs: float 
 
 
 def read_spectrum(path: str | os.PathLike):
-    """Read a spectrum stored as text by LabVIEW (.lvm, X column in Hz); dB values (re 1 unit)
-    become linear amplitudes. Returns a vm.Spectrum of kind "amplitude"."""
+    """Read a spectrum stored as text by LabVIEW (.lvm, X column in Hz).
+
+    dB values (re 1 unit) become linear amplitudes.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The .lvm file of an FFT export.
+
+    Returns
+    -------
+    Spectrum
+        Of kind "amplitude".
+
+    Raises
+    ------
+    ParameterError
+        For a file that holds no spectrum, or a damaged one.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> spec = vm.read_spectrum("fft_export.lvm")  # doctest: +SKIP
+    """
     from .lvm import read_lvm_spectrum
     p = Path(path)
     if not p.exists():

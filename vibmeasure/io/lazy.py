@@ -120,12 +120,42 @@ def _check_stored(d, path):
 
 def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: float | None = None,
                 quantity: str | None = None, unit: str | None = None, progress=None) -> LazyRecord:
-    """Open an HDF5 record lazily (out-of-core).
+    """Open an HDF5 record lazily (out-of-core): samples are read block by block when analysed.
 
-    A file in vibmeasure's schema needs nothing more; any other HDF5 file needs ``dataset`` (a
-    1-D or (n_channels, n_samples) dataset) and ``fs`` unless the dataset has an ``fs`` attribute.
-    A file vibmeasure wrote is verified against its SHA-256 first (one streamed pass over the
-    file, about 1 s per GB); ``progress(fraction)`` follows that pass.
+    A file in vibmeasure's schema needs nothing more; any other HDF5 file needs ``dataset`` (a 1-D or
+    (n_channels, n_samples) dataset) and ``fs`` unless the dataset has an ``fs`` attribute. A file
+    vibmeasure wrote is verified against its SHA-256 first (one streamed pass, about 1 s per GB).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The HDF5 file.
+    dataset : str, optional
+        The dataset of a foreign file.
+    fs : float, optional
+        Sampling rate in Hz when the file does not state it.
+    quantity, unit : str, optional
+        Labels for the data when the file does not give them.
+    progress : callable, optional
+        ``progress(fraction)`` follows the checksum pass.
+
+    Returns
+    -------
+    LazyRecord
+
+    Raises
+    ------
+    ParameterError
+        For a missing, damaged or unreadable file, or a missing ``dataset`` or ``fs``.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import vibmeasure as vm
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "run.h5"
+    >>> _ = vm.write(path, vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=2.0))
+    >>> vm.open(path).n_samples
+    1000
     """
     import json
     from .hdf5 import SCHEMA, _str_list

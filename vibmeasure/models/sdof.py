@@ -22,8 +22,38 @@ def coulomb_response(t, *, fn: float, friction_decay: float, amplitude: float, o
     """Closed-form dry-friction decay released from rest at ``amplitude`` at t = 0 (t >= 0).
 
     Each half cycle is a cosine about a centre shifted by the friction displacement mu = F/k
-    (= friction_decay / 4) against the motion; the turning amplitude falls by 2 mu per half cycle
-    until it is below mu and the mass sticks. ``order`` 1 and 2 give velocity and acceleration.
+    (= friction_decay / 4) against the motion; the turning amplitude falls by 2 mu per half cycle until
+    it is below mu and the mass sticks.
+
+    Parameters
+    ----------
+    t : array_like
+        Times in s.
+    fn : float
+        Undamped natural frequency in Hz.
+    friction_decay : float
+        Amplitude lost per cycle (4 F/k).
+    amplitude : float
+        Release amplitude.
+    order : {0, 1, 2}
+        Displacement, velocity or acceleration.
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Raises
+    ------
+    ParameterError
+        For values out of range.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> x = vm.synth.coulomb_response(np.array([0.0, 1.0]), fn=1.0, friction_decay=0.04, amplitude=1.0)
+    >>> [round(float(v), 3) for v in x]
+    [1.0, 0.96]
     """
     t = np.asarray(t, dtype=float)
     mu = friction_decay / 4.0

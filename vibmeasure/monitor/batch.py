@@ -52,7 +52,33 @@ def _tasks(task) -> tuple[str, ...]:
 
 
 def read_manifest(path) -> list[dict]:
-    """Rows of a manifest CSV, each with its ``file`` glob expanded (relative to the manifest)."""
+    """Rows of a manifest CSV, each with its ``file`` glob expanded (relative to the manifest).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The manifest: columns file, asset, point, channel, rpm, bearing, model, time, tach,
+        pulses_per_rev (any other column is an error).
+
+    Returns
+    -------
+    list of dict
+        One item per file.
+
+    Raises
+    ------
+    ParameterError
+        For a missing manifest, an unknown column or a glob that matches nothing.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import vibmeasure as vm
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> items = vm.synth.fleet(folder, n_measurements=2)
+    >>> len(vm.read_manifest(folder / "machines.csv")) > 0
+    True
+    """
     p = Path(path)
     if not p.is_file():
         raise ParameterError(f"manifest={str(path)!r} does not exist")
@@ -294,15 +320,61 @@ def _store_one(store, out, tasks, keep_raw, options):
 def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, workers: int | None = None,
           scheduler: str | None = None, force: bool = False, keep_raw: bool = False, fs: float | None = None,
           band=None, progress=None):
-    """Analyse many inputs into a :class:`vibmeasure.Store`; returns a DataFrame, one row per input
-    (file, status done / skipped / error, measurement id, message).
+    """Analyse many inputs into a :class:`vibmeasure.Store`.
 
-    ``task``: "ringdown", "modes", "spectrum", "diagnose", "compare" or several ("spectrum+diagnose").
-    ``store``: a path or a writable Store. ``client``: a ``dask.distributed.Client``; or ``workers=N``
-    starts a local Dask cluster on 127.0.0.1 (N processes, one thread each), or ``scheduler`` is the
-    address of an existing one ("tcp://host:8786"). Without them the batch runs serially. A task that
-    fails on a worker is retried twice (a worker that dies loses no input). ``progress(done, total)``
-    is called as inputs finish.
+    A bad file never stops the batch (it is stored as an error); inputs already stored (same content)
+    are skipped unless ``force``. Serially, or on Dask: only the client writes the store, and a task
+    that fails on a worker is retried twice.
+
+    Parameters
+    ----------
+    inputs : sequence of str or os.PathLike
+        Files, folders and globs.
+    task : str
+        "ringdown", "modes", "spectrum", "diagnose", "compare", "auto" (each file by what it holds:
+        ``core.dispatch.analysis_for``), or several joined by "+".
+    store : str, os.PathLike or Store
+        The store, created when missing.
+    manifest : str or os.PathLike, optional
+        A manifest CSV (``read_manifest``).
+    client : dask.distributed.Client, optional
+        An existing Dask client.
+    workers : int, optional
+        Start a local Dask cluster on 127.0.0.1 with this many processes.
+    scheduler : str, optional
+        Address of an existing Dask scheduler ("tcp://host:8786").
+    force : bool
+        Analyse inputs already in the store again.
+    keep_raw : bool
+        Store the raw records too.
+    fs : float, optional
+        Sampling rate for files without timing.
+    band : tuple of float, optional
+        (lo, hi) Hz for the modes task.
+    progress : callable, optional
+        ``progress(done, total)`` as inputs finish.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per input: file, status (done, skipped, error), measurement id, message.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown task, no input, or a store that cannot be opened.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, warnings
+    >>> import vibmeasure as vm
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = vm.write(folder / "decay.h5", vm.synth.free_decay(fn=12.0, zeta=0.02, fs=500.0, duration=6.0, seed=1))
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     rep = vm.batch([folder / "decay.h5"], task="ringdown", store=folder / "s.h5")
+    >>> rep["status"].tolist()
+    ['done']
     """
     from ..io.store import Store
     tasks = _tasks(task)

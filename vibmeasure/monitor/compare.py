@@ -76,13 +76,45 @@ class Comparison:
 
 def compare(measured, predicted, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.5, pair_rtol: float = 0.25,
             n_sigma: float = 3.0) -> Comparison:
-    """Compare measured modes with a prediction (model, baseline ModalEstimate or History).
+    """Compare measured modes with a prediction (a model, a baseline estimate or a History).
 
-    Per mode: deviation of fn and zeta in % and in units of the combined standard deviation, the
-    stiffness change the frequency shift implies (dk/k = (f_meas/f_pred)^2 - 1, about 2 df/f, mass
-    unchanged) and a verdict: "alarm" when |dfn| exceeds rtol_fn and n_sigma standard deviations,
-    "watch" when it exceeds half of rtol_fn (and is significant) or zeta deviates by more than
-    rtol_zeta, else "ok". Modes that find no partner within pair_rtol are listed.
+    Per mode: the deviation of fn and zeta in % and in units of the combined std, the stiffness change
+    the frequency shift implies (dk/k = (f_meas / f_pred)^2 - 1, mass unchanged), and a verdict: "alarm"
+    when |dfn| exceeds ``rtol_fn`` and ``n_sigma`` stds, "watch" when it exceeds half of ``rtol_fn``
+    (significantly) or zeta deviates by more than ``rtol_zeta``, else "ok".
+
+    Parameters
+    ----------
+    measured : ModalEstimate
+        The measurement.
+    predicted : model, ModalEstimate or History
+        Anything with ``modes()``, an estimate, or a baseline history.
+    rtol_fn : float
+        Relative frequency tolerance of an alarm.
+    rtol_zeta : float
+        Relative damping tolerance of a watch.
+    pair_rtol : float
+        Modes further apart than this (relative) find no partner.
+    n_sigma : float
+        Standard deviations a deviation must exceed to count.
+
+    Returns
+    -------
+    Comparison
+        ``verdict``, ``reason``, ``rows`` and ``to_frame()``.
+
+    Raises
+    ------
+    ParameterError
+        For a prediction without modes.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> est = vm.ringdown(vm.synth.free_decay(fn=10.0, zeta=0.02, fs=1000.0, duration=10.0, snr_db=40, seed=1))
+    >>> model = vm.models.SDOF(m=1.0, k=(2 * 3.141592653589793 * 10.0) ** 2, zeta=0.02)
+    >>> vm.compare(est, model).verdict
+    'ok'
     """
     meas = _as_estimate(measured, "measured")
     pred = _as_estimate(predicted, "predicted")

@@ -47,11 +47,46 @@ def _level(v, mu, dw, da, direction):
 
 def trend(store, *, asset: str | None = None, point: str | None = None, baseline_count: int = 8,
           horizon_days: float = 90.0):
-    """Verdicts per asset, point and metric as a DataFrame (one row per metric with its baseline,
-    limits, last value, slope and std per day, projected alarm date, the times the watch and alarm
-    levels were first held over two measurements, the verdict and its reason), sorted worst
-    first. ``store`` is a path or a :class:`vibmeasure.Store`. ``df.attrs["points"]`` and
-    ``df.attrs["assets"]`` hold the roll-ups (worst verdict per point and per asset)."""
+    """Verdicts per asset, point and metric of a store, worst first.
+
+    A baseline per point and metric from the first measurements; watch and alarm limits at 3 and 6
+    baseline stds in the metric's bad direction (never closer than a floor; ISO zones for velocity);
+    the trend slope with its std and the projected alarm date.
+
+    Parameters
+    ----------
+    store : str, os.PathLike or Store
+        The store.
+    asset, point : str, optional
+        Only this asset or point.
+    baseline_count : int
+        Measurements in the baseline.
+    horizon_days : float
+        A significant slope reaching the alarm limit within this many days is a watch.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per metric (baseline, limits, last value, slope, projected alarm date, verdict, reason);
+        ``attrs["points"]`` and ``attrs["assets"]`` hold the worst verdict per point and per asset.
+
+    Raises
+    ------
+    ParameterError
+        For a store that cannot be read.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib, warnings
+    >>> import vibmeasure as vm
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = vm.synth.fleet(folder / "fleet", n_measurements=6, fault_onset=3)
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     _ = vm.batch(task="diagnose", store=folder / "s.h5", manifest=folder / "fleet" / "machines.csv")
+    >>> sorted(vm.trend(folder / "s.h5", baseline_count=3).attrs["assets"])[:2]
+    ['pump-1', 'pump-2']
+    """
     import pandas as pd
     from ..io.store import Store
     st = store if isinstance(store, Store) else Store(store)

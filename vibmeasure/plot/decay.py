@@ -13,7 +13,36 @@ from ._style import _styled
 
 
 def decay_model(est: ModalEstimate, t: np.ndarray) -> np.ndarray:
-    """The fitted free decay of an estimate at times t (s, from the fit start), summed over modes."""
+    """The fitted free decay of an estimate at times t (s, from the fit start), summed over modes.
+
+    Parameters
+    ----------
+    est : ModalEstimate
+        A ``vm.ringdown`` estimate.
+    t : numpy.ndarray
+        Times in s from the fit's start.
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Raises
+    ------
+    ParameterError
+        Never for a ringdown estimate; modes without amplitude or phase are left out.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> rec = vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=4.0, snr_db=40, seed=1)
+    >>> y = plot.decay_model(vm.ringdown(rec), np.arange(100) / 500.0)
+    >>> y.shape
+    (100,)
+    """
     y = np.zeros_like(t, dtype=float)
     for fn, z, a, ph in zip(est.fn, est.zeta, est.amplitude, est.phase):
         if not (np.isfinite(fn) and np.isfinite(z) and np.isfinite(a) and np.isfinite(ph)):
@@ -27,7 +56,36 @@ def decay_model(est: ModalEstimate, t: np.ndarray) -> np.ndarray:
 def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
     """The record, the fitted decay and its envelope, and the residual (two stacked axes).
 
-    Returns the pair of axes (signal, residual).
+    Parameters
+    ----------
+    rec : Record
+        The ring-down.
+    est : ModalEstimate
+        Its ``vm.ringdown`` estimate.
+    channel : str or int, optional
+        The channel (default the one the estimate was fitted on).
+    axes : sequence of two Axes, optional
+        Where to draw (signal, residual).
+
+    Returns
+    -------
+    tuple of matplotlib.axes.Axes
+        (signal, residual).
+
+    Raises
+    ------
+    ParameterError
+        For a channel the estimate does not belong to.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> rec = vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=4.0, snr_db=40, seed=1)
+    >>> ax, axr = plot.plot_ringdown(rec, vm.ringdown(rec))
     """
     import matplotlib.pyplot as plt
     if not isinstance(rec, Record):
@@ -99,8 +157,38 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
 
 @_styled
 def plot_backbone(est: ModalEstimate, *, mode: int = 0, axes=None):
-    """The backbone of one mode of a ring-down estimate: fn and zeta versus amplitude (error bars:
-    one std per window) with the weakly nonlinear model of ``extras["backbone_model"]`` drawn over."""
+    """The backbone of one mode of a ring-down estimate: fn and zeta against amplitude (error bars: one
+    std per window) with the weakly nonlinear model of ``extras["backbone_model"]`` drawn over.
+
+    Parameters
+    ----------
+    est : ModalEstimate
+        A ``vm.ringdown`` estimate.
+    mode : int
+        The mode.
+    axes : sequence of two Axes, optional
+        Where to draw (fn, zeta).
+
+    Returns
+    -------
+    numpy.ndarray of matplotlib.axes.Axes
+        (fn, zeta).
+
+    Raises
+    ------
+    ParameterError
+        For a mode without a backbone (too few cycles above the noise).
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> rec = vm.synth.free_decay(fn=10.0, zeta=0.01, fs=500.0, duration=20.0, snr_db=50, seed=1)
+    >>> axes = plot.plot_backbone(vm.ringdown(rec))
+    """
     import matplotlib.pyplot as plt
     bb = est.extras.get("backbone")
     if bb is None or len(bb) == 0 or mode not in set(bb["mode"]):

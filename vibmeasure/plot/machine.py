@@ -9,10 +9,42 @@ from ._style import _styled
 
 @_styled
 def plot_diagnosis(rec, diag, *, axes=None):
-    """The squared-envelope spectrum that carries the bearing evidence (in dB over its floor) with the
+    """The picture of a machine diagnosis.
+
+    The squared-envelope spectrum that carries the bearing evidence (in dB over its floor) with the
     winning family's comb at its slip, its sidebands and the other families' expected lines; the fast
     kurtogram of that channel with the chosen band; the amplitude spectrum with the shaft orders; an
-    ISO 10816-3 severity gauge. Returns the axes (envelope, spectrum, gauge, kurtogram)."""
+    ISO 10816-3 severity gauge.
+
+    Parameters
+    ----------
+    rec : Record
+        The record diagnosed.
+    diag : Diagnosis
+        Its ``vm.diagnose`` result.
+    axes : sequence of Axes, optional
+        Where to draw (envelope, spectrum, gauge, kurtogram).
+
+    Returns
+    -------
+    tuple of matplotlib.axes.Axes
+        (envelope, spectrum, gauge, kurtogram).
+
+    Raises
+    ------
+    ParameterError
+        For a diagnosis of another record.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> rec = vm.synth.machine(fault="bearing_outer_race", rpm=1797, duration=2.0, seed=1)
+    >>> axes = plot.plot_diagnosis(rec, vm.diagnose(rec, rpm=1797, bearing="6205-2RS"))
+    """
     import matplotlib.pyplot as plt
 
     from ..signal.spectral import amplitude_spectrum
@@ -184,8 +216,48 @@ def _plot_kurtogram(ax, kg, band):
 @_styled
 def plot_trend(store, *, asset: str, point: str, metric: str, task: str | None = None, baseline_count: int = 8,
                ax=None):
-    """One metric of one point over time: the measurements, the baseline band (mean +- std of the
-    first ``baseline_count``), the watch and alarm limits of :func:`vibmeasure.trend` and the verdict."""
+    """One metric of one point over time: the measurements, the baseline band (mean +- std of the first
+    ``baseline_count``), the watch and alarm limits of :func:`vibmeasure.trend` and the verdict.
+
+    Parameters
+    ----------
+    store : str, os.PathLike or Store
+        The store.
+    asset, point : str
+        The asset and its measurement point.
+    metric : str
+        A trended metric (velocity_rms_mm_s, bearing_evidence, rms, fn1_hz).
+    task : str, optional
+        The task whose results hold the metric.
+    baseline_count : int
+        Measurements in the baseline.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ParameterError
+        For a metric that is not trended, or no result of it for the point.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> import tempfile, pathlib, warnings
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = vm.synth.fleet(folder / "fleet", n_measurements=6, fault_onset=3)
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     _ = vm.batch(task="diagnose", store=folder / "s.h5", manifest=folder / "fleet" / "machines.csv")
+    >>> ax = plot.plot_trend(folder / "s.h5", asset="pump-3", point="DE", metric="velocity_rms_mm_s", baseline_count=3)
+    """
     import matplotlib.pyplot as plt
 
     from ..monitor.trend import metric_history

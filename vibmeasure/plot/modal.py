@@ -12,8 +12,40 @@ from ._style import _styled
 
 @_styled
 def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
-    """Bode plot (magnitude, phase) of one FRF with its coherence, and the FRF synthesised from
-    a fit_modes estimate when given. Returns (magnitude, phase, coherence) axes."""
+    """Bode plot (magnitude, phase) of one FRF with its coherence, and the FRF synthesised from a
+    fit_modes estimate when given.
+
+    Parameters
+    ----------
+    frf : FRF
+        The FRFs.
+    est : ModalEstimate, optional
+        A ``fit_modes`` estimate to draw over.
+    output, input : int or str
+        The FRF row and column.
+    axes : sequence of three Axes, optional
+        Where to draw (magnitude, phase, coherence).
+
+    Returns
+    -------
+    tuple of matplotlib.axes.Axes
+        (magnitude, phase, coherence).
+
+    Raises
+    ------
+    ParameterError
+        For an unknown output or input.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> h = vm.synth.modal_frf(np.linspace(1, 100, 500), fn=[30.0], zeta=[0.02], shapes=[[1.0]])
+    >>> axes = plot.plot_frf(h)
+    """
     import matplotlib.pyplot as plt
 
     from ..core.results import FRF
@@ -59,7 +91,38 @@ def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
 
 @_styled
 def plot_nyquist(frf, *, output=0, input=0, band=None, ax=None):
-    """Nyquist plot (real vs imaginary) of one FRF, optionally within a band."""
+    """Nyquist plot (real against imaginary) of one FRF, optionally within a band.
+
+    Parameters
+    ----------
+    frf : FRF
+        The FRFs.
+    output, input : int or str
+        The FRF row and column.
+    band : tuple of float, optional
+        (lo, hi) Hz.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ParameterError
+        For an unknown output or input.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> h = vm.synth.modal_frf(np.linspace(1, 100, 500), fn=[30.0], zeta=[0.02], shapes=[[1.0]])
+    >>> ax = plot.plot_nyquist(h, band=(25, 35))
+    """
     import matplotlib.pyplot as plt
     if ax is None:
         _, ax = plt.subplots(figsize=(5.5, 5.5))
@@ -77,9 +140,40 @@ def plot_nyquist(frf, *, output=0, input=0, band=None, ax=None):
 
 @_styled
 def plot_stabilisation(est, *, frf=None, ax=None):
-    """The stabilisation diagram of a fit_modes or oma_ssi estimate: poles per model order (o new, f
-    stable in frequency, d also damping, s stable in frequency and damping, and for oma_ssi in shape),
-    the chosen modes, and |H| (fit_modes, with ``frf``) or the outputs' mean PSD (oma_ssi) behind it."""
+    """The stabilisation diagram of a fit_modes or oma_ssi estimate.
+
+    Poles per model order (o new, f stable in frequency, d also damping, s stable in frequency and
+    damping, and for oma_ssi in shape), the chosen modes, and |H| (fit_modes, with ``frf``) or the
+    outputs' mean PSD (oma_ssi) behind it.
+
+    Parameters
+    ----------
+    est : ModalEstimate
+        A ``fit_modes`` or ``oma_ssi`` estimate.
+    frf : FRF, optional
+        The FRFs behind a fit_modes diagram.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ParameterError
+        For an estimate without a stabilisation table.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> h = vm.synth.modal_frf(np.linspace(1, 100, 1000), fn=[30.0], zeta=[0.02], shapes=[[1.0]])
+    >>> ax = plot.plot_stabilisation(vm.fit_modes(h, band=(10, 60)), frf=h)
+    """
     import matplotlib.pyplot as plt
     if "stabilisation" not in est.extras:
         raise ParameterError("est must come from vm.fit_modes or vm.oma_ssi (it carries the stabilisation table)")
@@ -120,7 +214,35 @@ def plot_stabilisation(est, *, frf=None, ax=None):
 
 @_styled
 def plot_mac(matrix, *, labels=None, ax=None):
-    """MAC matrix as an image with the values written in."""
+    """A MAC matrix as an image with the values written in.
+
+    Parameters
+    ----------
+    matrix : array_like
+        The MAC matrix (``vm.mac``).
+    labels : sequence of str, optional
+        Mode labels.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ParameterError
+        For a matrix that is not 2-D.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> ax = plot.plot_mac(vm.mac(np.eye(3)))
+    """
     import matplotlib.pyplot as plt
     m = np.asarray(matrix, float)
     if ax is None:
@@ -142,8 +264,42 @@ def plot_mac(matrix, *, labels=None, ax=None):
 @_styled
 def plot_comparison(cmp, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.5, against: str = "model", ax=None):
     """Deviation of each measured fn from its prediction (%), coloured by verdict, with the alarm
-    tolerance +-rtol_fn and, where known, one-std error bars; on a figure of its own also the zeta
-    deviation (%) beside it, with its tolerance +-rtol_zeta. Returns the fn axes."""
+    tolerance and, where known, one-std error bars; on a figure of its own also the zeta deviation.
+
+    Parameters
+    ----------
+    cmp : Comparison
+        A ``vm.compare`` result.
+    rtol_fn : float
+        The frequency tolerance drawn.
+    rtol_zeta : float
+        The damping tolerance drawn.
+    against : {"model", "baseline"}
+        What the prediction is, for the labels.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw the fn deviations.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The fn axes.
+
+    Raises
+    ------
+    ParameterError
+        For an object that is no comparison.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> est = vm.ringdown(vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=8.0, snr_db=40, seed=1))
+    >>> cmp = vm.compare(est, vm.models.SDOF(m=1.0, k=(2 * np.pi * 10.1) ** 2, zeta=0.02))
+    >>> ax = plot.plot_comparison(cmp)
+    """
     import matplotlib.pyplot as plt
 
     from ..core._validate import positive
@@ -177,8 +333,38 @@ def plot_comparison(cmp, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.5, again
 
 @_styled
 def plot_singular_values(est, *, ax=None, n: int | None = None):
-    """Singular values of the output cross-spectral matrix (oma_fdd), in dB, with the selected modes
-    and their EFDD bells marked."""
+    """Singular values of the outputs' cross-spectral matrix (oma_fdd) in dB, with the modes and their
+    EFDD bells marked.
+
+    Parameters
+    ----------
+    est : ModalEstimate
+        A ``vm.oma_fdd`` estimate.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw.
+    n : int, optional
+        How many singular values (default all).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ParameterError
+        For an estimate that is not from oma_fdd.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> chain = vm.models.MDOF(np.eye(2), np.array([[2e4, -1e4], [-1e4, 1e4]]), modal_zeta=[0.02, 0.02])
+    >>> est = vm.oma_fdd(vm.synth.ambient(chain, fs=100.0, duration=300.0, seed=1), band=(1, 40))
+    >>> ax = plot.plot_singular_values(est)
+    """
     import matplotlib.pyplot as plt
     if "singular_values" not in est.extras:
         raise ParameterError("est must come from vm.oma_fdd (it carries the singular values)")

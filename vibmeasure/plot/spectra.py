@@ -13,13 +13,48 @@ from ._style import _styled
 @_styled
 def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: bool | None = None,
                   db: bool = False, fmax: float | None = None):
-    """A spectrum (one or all channels) with optional picked peaks and labelled reference lines.
+    """A spectrum (one or all channels) with picked peaks and labelled reference lines.
 
-    ``lines`` maps a label to a frequency in Hz (e.g. {"BPFO": 107.4}); ``log`` defaults to a
-    logarithmic amplitude axis for PSDs; ``db=True`` draws decibels re 1 unit (20 log10 of
-    amplitudes, 10 log10 of powers). The frequency axis ends at ``fmax``, by default where the
-    content ends (an envelope spectrum holds nothing above its demodulation bandwidth). Peak labels
-    that would print on top of each other are left out, strongest peaks first.
+    Peak labels that would print on top of each other are left out, strongest peaks first.
+
+    Parameters
+    ----------
+    spec : Spectrum
+        The spectrum.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw.
+    channel : str or int, optional
+        One channel (default all).
+    peaks : Peaks, optional
+        Picked peaks to mark and label.
+    lines : dict, optional
+        Label -> frequency in Hz (e.g. {"BPFO": 107.4}).
+    log : bool, optional
+        Logarithmic amplitude axis (default for PSDs).
+    db : bool
+        Decibels re 1 unit (20 log10 of amplitudes, 10 log10 of powers).
+    fmax : float, optional
+        End of the frequency axis (default where the content ends).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ParameterError
+        For an unknown channel.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+    >>> spec = vm.amplitude_spectrum(rec)
+    >>> ax = plot.plot_spectrum(spec, peaks=vm.pick_peaks(spec, n=5), lines={"1X": 29.95})
     """
     import matplotlib.pyplot as plt
 
@@ -110,9 +145,40 @@ def _label_without_collisions(ax, xs, ys, texts, *, size: float = ANNOTATION_SIZ
 
 @_styled
 def plot_srs(spec, *, ax=None, tripartite: bool | None = None):
-    """Shock response spectrum on log axes. For pseudo-velocity output (or ``tripartite=True`` with
-    any output) the tripartite grid: pseudo-velocity against frequency, with lines of constant
-    relative displacement (falling) and constant pseudo-acceleration (rising)."""
+    """Shock response spectrum on log axes.
+
+    For pseudo-velocity output (or ``tripartite=True``) the tripartite grid: pseudo-velocity against
+    frequency with lines of constant relative displacement (falling) and pseudo-acceleration (rising).
+
+    Parameters
+    ----------
+    spec : ShockSpectrum
+        A ``vm.srs`` result.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default a new figure).
+    tripartite : bool, optional
+        Draw the tripartite grid (default for pseudo-velocity output).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+
+    Raises
+    ------
+    ParameterError
+        For an object that is no shock response spectrum.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> t = np.arange(1000) / 20000.0
+    >>> sp = vm.srs(vm.Record.from_array(np.where(t < 0.002, 50 * np.sin(np.pi * t / 0.002), 0.0), fs=20000.0, unit="g"))
+    >>> ax = plot.plot_srs(sp)
+    """
     import matplotlib.pyplot as plt
     if ax is None:
         _, ax = plt.subplots(figsize=(7, 5.5), layout="constrained")
@@ -155,8 +221,37 @@ def plot_srs(spec, *, ax=None, tripartite: bool | None = None):
 
 @_styled
 def plot_transmissibility(tr, *, ax=None):
-    """Measured |T| (and the model's, where given) on log axes, coherence below, the isolation
-    region (|T| < 1) shaded."""
+    """Measured |T| (and the model's, where given) on log axes, coherence below, the isolation region
+    (|T| < 1) shaded.
+
+    Parameters
+    ----------
+    tr : Transmissibility
+        A ``vm.transmissibility`` result.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw |T|.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The |T| axes.
+
+    Raises
+    ------
+    ParameterError
+        For an object that is no transmissibility.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> from vibmeasure import plot
+    >>> iso = vm.models.SDOF(m=1.0, k=3948.0, zeta=0.05)
+    >>> tr = vm.transmissibility(vm.synth.base_excited(iso, fs=500.0, duration=30.0, seed=1), base="base", top="top")
+    >>> ax = plot.plot_transmissibility(tr)
+    """
     import matplotlib.pyplot as plt
     if ax is None:
         fig, (ax, axc) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, height_ratios=(3, 1), layout="constrained")

@@ -68,9 +68,51 @@ def analyse_input(path, *, rpm=None, bearing=None, band=None, model=None):
 
 def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration measurement report", rpm=None,
            bearing=None, band=None, model=None, summary=None) -> Path:
-    """Write a self-contained HTML report of ``inputs`` (files) and, with ``store``, the fleet trends;
-    returns its path. A file that cannot be analysed is listed with its error and the others are still
-    reported. Written atomically: never a half-written report."""
+    """Write a self-contained HTML report of input files and, with ``store``, the fleet trends.
+
+    Each input gets the section its content calls for (``core.dispatch.analysis_for``); a file that
+    cannot be analysed is listed with its error and the others are still reported. Written atomically.
+
+    Parameters
+    ----------
+    inputs : sequence of str or os.PathLike
+        Record files.
+    out : str or os.PathLike
+        The HTML file.
+    store : str, os.PathLike or Store, optional
+        A store whose fleet trends are reported too.
+    title : str
+        The report's title.
+    rpm : float, optional
+        Shaft speed: records are diagnosed as machines.
+    bearing : str or Bearing, optional
+        The bearing for the diagnosis.
+    band : tuple of float, optional
+        (lo, hi) Hz for ringdown and fit_modes.
+    model : str or os.PathLike, optional
+        A TOML model each estimate is compared with.
+    summary : list of str, optional
+        Lines for the report's summary.
+
+    Returns
+    -------
+    pathlib.Path
+        The report written.
+
+    Raises
+    ------
+    ParameterError
+        For nothing to report, or an output folder that does not exist.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import vibmeasure as vm
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = vm.write(folder / "decay.h5", vm.synth.free_decay(fn=12.0, zeta=0.02, fs=500.0, duration=6.0, seed=1))
+    >>> vm.report([folder / "decay.h5"], folder / "r.html").suffix
+    '.html'
+    """
     import jinja2
     import scipy
 

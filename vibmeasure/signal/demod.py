@@ -25,7 +25,41 @@ def _band(rec, band):
 
 @memory_guard
 def envelope(rec, *, band, channel=None, order: int = 4, fs: float | None = None) -> Record:
-    """Envelope of one channel: zero-phase Butterworth band-pass, then |analytic signal|."""
+    """Envelope of one channel: zero-phase Butterworth band-pass, then |analytic signal|.
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The record.
+    band : tuple of float
+        (lo, hi) Hz of the band-pass.
+    channel : str or int, optional
+        The channel (default the first that is not a force).
+    order : int
+        Butterworth order.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+        One channel, the envelope, in the channel's unit.
+
+    Raises
+    ------
+    ParameterError
+        For a band outside (0, fs/2) or bad data.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> t = np.arange(8192) / 8192.0
+    >>> x = (1 + 0.5 * np.cos(2 * np.pi * 10 * t)) * np.sin(2 * np.pi * 1000 * t)
+    >>> env = vm.envelope(vm.Record.from_array(x, fs=8192.0), band=(800, 1200))
+    >>> round(float(np.median(env.data[0])), 1)
+    1.0
+    """
     rec = as_record(rec, fs=fs)
     lo, hi = _band(rec, band)
     if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or not 1 <= order <= 12:
@@ -46,10 +80,44 @@ def envelope_spectrum(rec, *, band, channel=None, window="hann", nperseg: int | 
                       fs: float | None = None, progress=None) -> Spectrum:
     """Amplitude spectrum of the squared envelope (mean removed) of the band-passed channel.
 
-    The squared envelope keeps the fault's repetition lines sharp (Randall & Antoni); unit is the
-    channel unit squared. Without ``nperseg`` the whole record is one segment. A lazy record
-    (vm.open) is streamed in segments of ``nperseg`` (default 2^18) with half overlap, each
-    demodulated in its band, so memory stays bounded; ``progress(fraction)`` reports the blocks.
+    The squared envelope keeps a fault's repetition lines sharp (Randall & Antoni 2011); its unit is
+    the channel's unit squared. A lazy record is streamed in segments, each demodulated in its band,
+    so memory stays bounded.
+
+    Parameters
+    ----------
+    rec : Record, LazyRecord or array_like
+        The record.
+    band : tuple of float
+        (lo, hi) Hz of the demodulation band (below fs/2).
+    channel : str or int, optional
+        The channel (default the first that is not a force).
+    window : str, tuple or array_like
+        Window of the spectrum.
+    nperseg : int, optional
+        Segment length (default: the whole record; a lazy record 2^18 with half overlap).
+    fs : float, optional
+        Sampling rate for an array.
+    progress : callable, optional
+        ``progress(fraction)`` as a lazy record's blocks finish.
+
+    Returns
+    -------
+    Spectrum
+        Of kind "envelope".
+
+    Raises
+    ------
+    ParameterError
+        For a band outside (0, fs/2) or bad data.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.machine(fault="bearing_outer_race", rpm=1797, duration=2.0, seed=1)
+    >>> env = vm.envelope_spectrum(rec, band=(2500, 4500))
+    >>> env.kind
+    'envelope'
     """
     from ..io.lazy import LazyRecord
     from .spectral import amplitude_spectrum, power_unit
@@ -169,9 +237,45 @@ def at_times(x, fs, t_grid):
 
 def order_track(rec, *, channel=None, tach=None, rpm_profile=None, samples_per_rev: int = 64,
                 pulses_per_rev: int = 1, fs: float | None = None) -> Record:
-    """Angular resampling: the channel at equal shaft-angle steps (``samples_per_rev`` per
-    revolution). The result's ``fs`` is in samples per revolution, so its spectrum is an order
-    spectrum (1.0 = 1X) however the speed varied."""
+    """Angular resampling: the channel at equal shaft-angle steps.
+
+    The result's ``fs`` is in samples per revolution, so its spectrum is an order spectrum (1.0 = 1X)
+    however the speed varied.
+
+    Parameters
+    ----------
+    rec : Record
+        The record.
+    channel : str or int, optional
+        The vibration channel.
+    tach : str, int or array_like, optional
+        The tachometer channel (or its samples).
+    rpm_profile : array_like, optional
+        One rpm per sample, instead of a tachometer.
+    samples_per_rev : int
+        Samples per revolution of the result.
+    pulses_per_rev : int
+        Tachometer pulses per revolution.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+        The channel in the angle domain.
+
+    Raises
+    ------
+    ParameterError
+        Without tach or rpm_profile, or with too few revolutions.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> run = vm.synth.machine(fault="unbalance", rpm=(1500, 2100), duration=4.0, tach=1, seed=1)
+    >>> vm.order_track(run, channel="acc", tach="tach", samples_per_rev=64).fs
+    64.0
+    """
     rec = as_record(rec, fs=fs)
     i = response_channel(rec, channel)
     if isinstance(samples_per_rev, bool) or not isinstance(samples_per_rev, (int, np.integer)) or samples_per_rev < 4:
@@ -189,9 +293,45 @@ def order_track(rec, *, channel=None, tach=None, rpm_profile=None, samples_per_r
 
 def time_synchronous_average(rec, *, channel=None, tach=None, rpm_profile=None, samples_per_rev: int = 256,
                              pulses_per_rev: int = 1, fs: float | None = None) -> Record:
-    """Average of the angle-resampled signal over whole revolutions: what turns with the shaft stays,
-    the rest (noise, other shafts, bearing impacts that slip) averages out by about 1/sqrt(revs).
-    Returns one revolution (``samples_per_rev`` samples, fs in samples per revolution)."""
+    """Average of the angle-resampled signal over whole revolutions.
+
+    What turns with the shaft stays; the rest (noise, other shafts, bearing impacts that slip) averages
+    out by about 1/sqrt(revolutions).
+
+    Parameters
+    ----------
+    rec : Record
+        The record.
+    channel : str or int, optional
+        The vibration channel.
+    tach : str, int or array_like, optional
+        The tachometer channel (or its samples).
+    rpm_profile : array_like, optional
+        One rpm per sample, instead of a tachometer.
+    samples_per_rev : int
+        Samples per revolution.
+    pulses_per_rev : int
+        Tachometer pulses per revolution.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+        One revolution (``samples_per_rev`` samples, fs in samples per revolution).
+
+    Raises
+    ------
+    ParameterError
+        Without tach or rpm_profile, or with too few revolutions.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> run = vm.synth.machine(fault="unbalance", rpm=1797, duration=4.0, tach=1, seed=1)
+    >>> vm.time_synchronous_average(run, channel="acc", tach="tach").n_samples
+    256
+    """
     ang_rec = order_track(rec, channel=channel, tach=tach, rpm_profile=rpm_profile, samples_per_rev=samples_per_rev,
                           pulses_per_rev=pulses_per_rev, fs=fs)
     start = int((-ang_rec.meta["first_rev"] * samples_per_rev) % samples_per_rev)

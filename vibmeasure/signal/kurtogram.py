@@ -117,13 +117,45 @@ def kurtogram_of(x: np.ndarray | None, fs: float, *, min_bandwidth: float, max_l
 def kurtogram(rec, *, channel=None, min_bandwidth: float | None = None, max_level: float | None = None,
               criterion: str = "kurtosis", cyclic_max: float | None = None, min_frequency: float = 0.0,
               fs: float | None = None) -> Kurtogram:
-    """Fast kurtogram (1/3-binary tree) and infogram of one channel.
+    """Fast kurtogram (1/3-binary tree) and infogram of one channel (Antoni 2007, 2016).
 
-    ``min_bandwidth`` (Hz, default fs/64) bounds the narrowest band: for bearings at least three times
-    the highest fault frequency, so the envelope carries its third harmonic. ``criterion`` chooses the
-    band: "kurtosis" (impulsiveness) or "negentropy" (the infogram's average of impulsiveness and
-    envelope-spectrum lines up to ``cyclic_max`` Hz, default ``min_bandwidth``). Bands whose lower
-    edge lies below ``min_frequency`` (Hz) are left out (NaN): shaft harmonics live there.
+    Parameters
+    ----------
+    rec : Record or array_like
+        The record.
+    channel : str or int, optional
+        The channel.
+    min_bandwidth : float, optional
+        Narrowest band in Hz (default fs/64): for bearings at least three times the highest fault
+        frequency, so the envelope carries its third harmonic.
+    max_level : float, optional
+        Deepest level of the tree.
+    criterion : {"kurtosis", "negentropy"}
+        Impulsiveness, or the infogram's average of impulsiveness and envelope-spectrum lines.
+    cyclic_max : float, optional
+        Highest envelope frequency the negentropy weighs (default ``min_bandwidth``).
+    min_frequency : float
+        Bands whose lower edge lies below it are left out (NaN): shaft harmonics live there.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Kurtogram
+        The map and the best band (``band``, Hz).
+
+    Raises
+    ------
+    ParameterError
+        For bad parameters or data.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.machine(fault="bearing_outer_race", rpm=1797, duration=2.0, seed=1)
+    >>> kg = vm.kurtogram(rec, min_bandwidth=600, min_frequency=1500)
+    >>> kg.band[0] >= 1500.0                      # above the shaft harmonics' region
+    True
     """
     rec = as_record(rec, fs=fs)
     i = response_channel(rec, channel)
@@ -163,8 +195,39 @@ def ses_power(X: np.ndarray, n: int, fs: float, band: tuple, f_max: float) -> tu
 
 
 def band_ses(rec, *, band, f_max: float | None = None, channel=None, fs: float | None = None):
-    """Squared-envelope spectrum of one band computed in the frequency domain (ideal band-pass):
-    ``(freq, values)`` up to ``f_max`` (default the band's width), at the record's resolution."""
+    """Squared-envelope spectrum of one band computed in the frequency domain (ideal band-pass).
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The record.
+    band : tuple of float
+        (lo, hi) Hz.
+    f_max : float, optional
+        Highest envelope frequency (default the band's width).
+    channel : str or int, optional
+        The channel.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (freq, values) at the record's resolution.
+
+    Raises
+    ------
+    ParameterError
+        For a band outside (0, fs/2).
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.machine(fault="bearing_outer_race", rpm=1797, duration=2.0, seed=1)
+    >>> freq, ses = vm.band_ses(rec, band=(2500, 4500), f_max=500.0)
+    >>> bool(499.0 <= freq[-1] <= 501.0)   # up to f_max, at the record's 0.5 Hz resolution
+    True
+    """
     from ..core._validate import check_band
     rec = as_record(rec, fs=fs)
     i = response_channel(rec, channel)

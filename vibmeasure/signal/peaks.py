@@ -115,9 +115,41 @@ def pick_peaks(spec: Spectrum, *, n: int | None = None, prominence: float | None
                min_distance_hz: float | None = None, channel=0) -> Peaks:
     """Peaks of one channel of a spectrum, strongest first, located and scaled to a fraction of a bin.
 
-    ``prominence`` in the spectrum's unit (default: 10x the median level, i.e. about 20 dB above
-    the floor of an amplitude spectrum); ``n`` keeps the n strongest; ``band`` (lo, hi) Hz;
-    ``min_distance_hz`` between peaks.
+    Each peak is refined with the window's own main-lobe shape (sub-bin frequency and amplitude).
+
+    Parameters
+    ----------
+    spec : Spectrum
+        An amplitude or power spectrum.
+    n : int, optional
+        Keep the n strongest.
+    prominence : float, optional
+        In the spectrum's unit (default 10 x the median level: about 20 dB above the floor).
+    band : tuple of float, optional
+        (lo, hi) Hz to search.
+    min_distance_hz : float, optional
+        Smallest distance between two peaks.
+    channel : str or int
+        The channel.
+
+    Returns
+    -------
+    Peaks
+        ``freq``, ``amplitude``, ``prominence``; ``to_frame()`` gives a table.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown channel or a band outside the spectrum.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> t = np.arange(4096) / 1024.0
+    >>> rec = vm.Record.from_array(np.sin(2 * np.pi * 100.3 * t), fs=1024.0)
+    >>> round(float(vm.pick_peaks(vm.amplitude_spectrum(rec), n=1).freq[0]), 2)
+    100.3
     """
     if not isinstance(spec, Spectrum):
         raise ParameterError(f"spec must be a vm.Spectrum, got {type(spec).__name__}")
@@ -190,10 +222,43 @@ def _channel_floor(spec, channel, floor):
 
 def harmonic_family(spec: Spectrum, f0: float | None = None, *, n_harmonics: int = 10, channel=0,
                     rtol: float = 2e-3, floor: float | None = None) -> dict:
-    """Harmonics 1X, 2X, ... of a fundamental (given, or the one whose harmonics explain most of the
-    strongest peaks). Each harmonic is searched within max(1.5 df, rtol * k f0) of k f0.
+    """Harmonics 1X, 2X, ... of a fundamental: given, or the one whose harmonics explain most peaks.
 
-    Returns {"f0_hz", "lines": [{order, expected_hz, found_hz, amplitude}], "found": count}.
+    Each harmonic is searched within max(1.5 df, rtol x k f0) of k f0.
+
+    Parameters
+    ----------
+    spec : Spectrum
+        An amplitude spectrum.
+    f0 : float, optional
+        The fundamental in Hz (default: found from the strongest peaks).
+    n_harmonics : int
+        How many harmonics to look for.
+    channel : str or int
+        The channel.
+    rtol : float
+        Relative search width per harmonic.
+    floor : float, optional
+        A line below it counts as not found (default: from the spectrum's median).
+
+    Returns
+    -------
+    dict
+        {"f0_hz", "lines": [{order, expected_hz, found_hz, amplitude}], "found": count}.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown channel or a fundamental outside the spectrum.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> t = np.arange(8192) / 1024.0
+    >>> x = sum(np.sin(2 * np.pi * k * 30.0 * t) / k for k in (1, 2, 3))
+    >>> vm.harmonic_family(vm.amplitude_spectrum(vm.Record.from_array(x, fs=1024.0)), 30.0)["found"] >= 3
+    True
     """
     if isinstance(n_harmonics, bool) or not isinstance(n_harmonics, (int, np.integer)) or n_harmonics < 1:
         raise ParameterError(f"n_harmonics={n_harmonics!r} must be an integer >= 1")
@@ -238,9 +303,42 @@ def harmonic_family(spec: Spectrum, f0: float | None = None, *, n_harmonics: int
 
 def sideband_family(spec: Spectrum, carrier: float, spacing: float, *, n: int = 3, channel=0,
                     floor: float | None = None) -> dict:
-    """Lines at carrier + k spacing, k = -n..n, each searched within max(1.5 df, spacing / 10).
+    """Lines at carrier + k x spacing, k = -n..n, each searched within max(1.5 df, spacing / 10).
 
-    Returns {"carrier_hz", "spacing_hz", "lines": [{order, expected_hz, found_hz, amplitude}], "found"}.
+    Parameters
+    ----------
+    spec : Spectrum
+        An amplitude spectrum.
+    carrier : float
+        The carrier in Hz (a gear mesh, a bearing line).
+    spacing : float
+        The sideband spacing in Hz (a shaft speed).
+    n : int
+        Sidebands on each side.
+    channel : str or int
+        The channel.
+    floor : float, optional
+        A line below it counts as not found.
+
+    Returns
+    -------
+    dict
+        {"carrier_hz", "spacing_hz", "lines": [{order, expected_hz, found_hz, amplitude}], "found": how many
+    sidebands (the carrier not counted) stand out}.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown channel or lines outside the spectrum.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> t = np.arange(8192) / 1024.0
+    >>> x = (1 + 0.5 * np.cos(2 * np.pi * 10.0 * t)) * np.sin(2 * np.pi * 200.0 * t)
+    >>> vm.sideband_family(vm.amplitude_spectrum(vm.Record.from_array(x, fs=1024.0)), 200.0, 10.0, n=1)["found"]
+    2
     """
     if not (np.isfinite(carrier) and np.isfinite(spacing)) or carrier <= 0 or spacing <= 0:
         raise ParameterError(f"carrier={carrier!r} and spacing={spacing!r} must be > 0 Hz")

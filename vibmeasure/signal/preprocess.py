@@ -30,7 +30,34 @@ def _finite(rec: Record, what: str):
 
 
 def detrend(rec, *, type: str = "linear", fs: float | None = None) -> Record:
-    """Remove the mean ("constant") or the least-squares line ("linear") of every channel."""
+    """Remove the mean ("constant") or the least-squares line ("linear") of every channel.
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The record.
+    type : {"linear", "constant"}
+        What to remove.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For an unknown type.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> rec = vm.Record.from_array(np.arange(100.0), fs=10.0)
+    >>> float(np.abs(vm.detrend(rec).data).max()) < 1e-9
+    True
+    """
     rec = as_record(rec, fs=fs)
     if type not in ("constant", "linear"):
         raise ParameterError(f"type={type!r} must be 'constant' or 'linear'")
@@ -39,8 +66,42 @@ def detrend(rec, *, type: str = "linear", fs: float | None = None) -> Record:
 
 
 def filter(rec, *, kind: str, cutoff, order: int = 4, zero_phase: bool = True, fs: float | None = None) -> Record:
-    """Butterworth filter in second-order sections: kind "lowpass", "highpass" (cutoff in Hz) or
-    "bandpass", "bandstop" (cutoff = (lo, hi) Hz); zero-phase (forward-backward) by default."""
+    """Butterworth filter in second-order sections, zero-phase (forward-backward) by default.
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The record.
+    kind : {"lowpass", "highpass", "bandpass", "bandstop"}
+        The filter.
+    cutoff : float or tuple of float
+        Hz; (lo, hi) for "bandpass" and "bandstop".
+    order : int
+        Butterworth order.
+    zero_phase : bool
+        Forward-backward (no phase shift, order doubled) or causal.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For an unknown kind or a cutoff outside (0, fs/2).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> t = np.arange(4000) / 1000.0
+    >>> rec = vm.Record.from_array(np.sin(2 * np.pi * 5 * t) + np.sin(2 * np.pi * 200 * t), fs=1000.0)
+    >>> low = vm.filter(rec, kind="lowpass", cutoff=50.0)
+    >>> round(float(low.data[0, 1000:3000].std() * np.sqrt(2)), 2)
+    1.0
+    """
     rec = as_record(rec, fs=fs)
     if kind not in ("lowpass", "highpass", "bandpass", "bandstop"):
         raise ParameterError(f"kind={kind!r} must be 'lowpass', 'highpass', 'bandpass' or 'bandstop'")
@@ -63,7 +124,34 @@ def filter(rec, *, kind: str, cutoff, order: int = 4, zero_phase: bool = True, f
 
 
 def decimate(rec, factor: int, *, fs: float | None = None) -> Record:
-    """Low-pass (zero-phase, order-8 Chebyshev I at 0.8 of the new Nyquist) and keep every factor-th sample."""
+    """Low-pass (zero-phase, order-8 Chebyshev I at 0.8 of the new Nyquist) and keep every factor-th sample.
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The record.
+    factor : int
+        Decimation factor (2 or more).
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+        At fs / factor.
+
+    Raises
+    ------
+    ParameterError
+        For a factor below 2 or too short a record.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> vm.decimate(vm.Record.from_array(np.zeros(1000), fs=1000.0), 4).fs
+    250.0
+    """
     rec = as_record(rec, fs=fs)
     if isinstance(factor, bool) or not isinstance(factor, (int, np.integer)) or factor < 1:
         raise ParameterError(f"factor={factor!r} must be an integer >= 1")
@@ -77,7 +165,33 @@ def decimate(rec, factor: int, *, fs: float | None = None) -> Record:
 
 
 def resample(rec, fs_new: float, *, fs: float | None = None) -> Record:
-    """Polyphase resampling to ``fs_new`` Hz (rational ratio, Kaiser-windowed anti-alias filter)."""
+    """Polyphase resampling to a new rate (rational ratio, Kaiser-windowed anti-alias filter).
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The record.
+    fs_new : float
+        The new sampling rate in Hz.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For a rate that is not positive.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> vm.resample(vm.Record.from_array(np.zeros(1000), fs=1000.0), 2048.0).fs
+    2048.0
+    """
     rec = as_record(rec, fs=fs)
     fs_new = positive(fs_new, "fs_new")
     ratio = Fraction(fs_new / rec.fs).limit_denominator(1000)
@@ -104,24 +218,83 @@ def integrate(rec, *, method: str = "frequency", highpass: float = DEFAULT_HIGHP
               fs: float | None = None) -> Record:
     """Acceleration -> velocity, velocity -> displacement, in SI units (g becomes m/s^2 first).
 
-    Both methods first remove the mean and continue the record past both ends by linear prediction
-    (a Burg AR model, then a smooth taper to zero over 32 periods of the corner), so the transform's
-    wrap-around and the filters' start-up fall outside the record. ``method="frequency"``: X(f) /
-    (i 2 pi f) with every line below ``highpass`` Hz set to zero: a sine of amplitude A at f becomes
-    A / (2 pi f) within 0.1 % in the middle 80 % of the record for any f above 1.25 x the corner,
-    whole periods or not. ``method="time"``: zero-phase 4th-order Butterworth high-pass at
-    ``highpass``, trapezoidal integration, then the drift removed (linear detrend and the same
-    high-pass); away from the ends its RMS agrees with the frequency method within 1 %. The corner
-    (default 2 Hz) keeps low-frequency noise and sensor offset from blowing up; set it below the
-    lowest frequency of interest. Displacement cannot be integrated.
+    Both methods remove the mean and continue the record past both ends by linear prediction (Burg
+    AR), so the transform's wrap-around and the filters' start-up fall outside the record.
+    "frequency": X(f) / (i 2 pi f) with every line below ``highpass`` set to zero (a sine at f above
+    1.25 x the corner integrates within 0.1 %); "time": zero-phase Butterworth high-pass, trapezoid,
+    then the drift removed (its RMS agrees with the frequency method within 1 % away from the ends).
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        Acceleration or velocity with a known unit.
+    method : {"frequency", "time"}
+        How to integrate.
+    highpass : float
+        Corner in Hz: keeps low-frequency noise and offsets from blowing up; set it below the lowest
+        frequency of interest.
+    channels : str, int or list, optional
+        Channels to integrate (default all).
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+        Velocity in m/s or displacement in m.
+
+    Raises
+    ------
+    ParameterError
+        For displacement, an unknown unit or a corner outside (0, fs/2).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> t = np.arange(20000) / 1000.0
+    >>> acc = vm.Record.from_array(np.sin(2 * np.pi * 10 * t), fs=1000.0, unit="m/s^2")
+    >>> v = vm.integrate(acc)
+    >>> round(float(np.abs(v.data[0, 5000:15000]).max() * 2 * np.pi * 10), 2)
+    1.0
     """
     return _calculus(rec, +1, method, highpass, channels, fs)
 
 
 @memory_guard
 def differentiate(rec, *, method: str = "frequency", channels=None, fs: float | None = None) -> Record:
-    """Displacement -> velocity, velocity -> acceleration, in SI units (frequency domain: X(f) i 2 pi f,
-    or central differences with ``method="time"``)."""
+    """Displacement -> velocity, velocity -> acceleration, in SI units.
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        Displacement or velocity with a known unit.
+    method : {"frequency", "time"}
+        X(f) i 2 pi f, or central differences.
+    channels : str, int or list, optional
+        Channels to differentiate (default all).
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+        Velocity in m/s or acceleration in m/s^2.
+
+    Raises
+    ------
+    ParameterError
+        For acceleration or an unknown unit.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> t = np.arange(2000) / 1000.0
+    >>> x = vm.Record.from_array(np.sin(2 * np.pi * 10 * t), fs=1000.0, unit="m")
+    >>> vm.differentiate(x).channels[0].unit
+    'm/s'
+    """
     return _calculus(rec, -1, method, 0.0, channels, fs)
 
 

@@ -469,9 +469,45 @@ def gate(x, runs, ramp: int) -> np.ndarray:
 
 def despike(rec, *, fs: float | None = None, sigma: float = SPIKE_SIGMA,
             isolation: float = SPIKE_ISOLATION) -> Record:
-    """The record with every isolated spike (``isolated_spikes``) replaced by its AR interpolation
-    (``fill``); a QualityWarning names each channel repaired and how many samples. ``sigma`` and
-    ``isolation`` are the two thresholds (defaults ``SPIKE_SIGMA``, ``SPIKE_ISOLATION``)."""
+    """The record with every isolated spike replaced by its AR interpolation.
+
+    A spike is a single sample (or a pair) far from both neighbours and from the running median
+    (``isolated_spikes``); it is filled by least-squares AR interpolation (``fill``, Janssen et al.
+    1986). A QualityWarning names each channel repaired and how many samples.
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The record.
+    fs : float, optional
+        Sampling rate for an array.
+    sigma : float
+        Departure from the running median, in robust standard deviations, that marks a spike.
+    isolation : float
+        How much further out than its neighbours a spike must stand.
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For bad thresholds or data.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> x = np.sin(np.arange(4000) / 7.0)
+    >>> x[1000] = 50.0
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("ignore")
+    ...     clean = vm.despike(vm.Record.from_array(x, fs=1000.0))
+    >>> bool(abs(clean.data[0, 1000]) < 1.1)
+    True
+    """
     from .preprocess import _finite
     rec = as_record(rec, fs=fs)
     _thresholds(sigma, isolation)

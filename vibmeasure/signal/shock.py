@@ -189,14 +189,52 @@ def srs(rec, *, fn=None, zeta: float | None = None, Q: float | None = None, kind
         fs: float | None = None) -> ShockSpectrum:
     """Shock response spectrum of a base acceleration record.
 
-    ``fn``: natural frequencies (Hz); default 1/``octave`` per octave from max(fs/16384, 1 Hz) to fs/4.
-    Damping by ``zeta`` (default 0.05) or ``Q`` (Q = 1/(2 zeta); Q = 10 is zeta = 0.05). ``kind``:
-    "maximax" (largest peak at any time), "primary" (during the pulse: up to ``pulse_end`` seconds,
-    default the end of the record) or "residual" (after it, including one cycle of free vibration
-    past the record's end); all three are computed and kept in ``values``, ``kind`` only picks the one
-    the CLI shows first. ``output``: "acceleration" (absolute, in the input's unit),
-    "pseudo_velocity" (wn z, m/s) or "relative_displacement" (z, m). Velocity or displacement input
-    is refused (differentiate it first); acceleration in g or in/s^2 is converted.
+    Each oscillator is the ramp-invariant recursive filter (Smallwood), exact at the samples for an
+    input linear between them; oscillators above fs/32 run on a finer interpolated input, and peaks are
+    refined between samples. All three kinds are computed and kept in ``values``.
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        Base acceleration (g or in/s^2 are converted); velocity or displacement is refused.
+    fn : array_like, optional
+        Natural frequencies in Hz; default 1/``octave`` per octave from max(fs/16384, 1 Hz) to fs/4.
+    zeta : float, optional
+        Damping ratio of the oscillators (default 0.05).
+    Q : float, optional
+        Quality factor Q = 1/(2 zeta), instead of ``zeta``.
+    kind : {"maximax", "primary", "residual"}
+        The kind the command line shows first: largest peak at any time, during the pulse, or after it.
+    output : {"acceleration", "pseudo_velocity", "relative_displacement"}
+        Response quantity: absolute acceleration (input's unit), wn z (m/s) or z (m).
+    channel : str or int, optional
+        The acceleration channel (default the first that is not a force).
+    octave : float
+        Spacing of the default natural frequencies, in octaves.
+    pulse_end : float, optional
+        End of the pulse in s (primary before, residual after; default the record's end).
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    ShockSpectrum
+        ``fn``, ``values`` (dict kind -> array), ``unit``, ``zeta``, ``input_peak``.
+
+    Raises
+    ------
+    ParameterError
+        For velocity or displacement input, both zeta and Q, or natural frequencies outside (0, fs/2).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> t = np.arange(1000) / 20000.0
+    >>> pulse = np.where(t < 0.002, 50.0 * np.sin(np.pi * t / 0.002), 0.0)
+    >>> sp = vm.srs(vm.Record.from_array(pulse, fs=20000.0, unit="g"), Q=10)
+    >>> bool(sp.values["maximax"].max() > 50.0)
+    True
     """
     rec = as_record(rec, fs=fs)
     if kind not in KINDS:
@@ -277,12 +315,46 @@ class Transmissibility:
 
 def transmissibility(rec, *, base, top, model=None, nperseg: int | None = None, min_coherence: float = 0.95,
                      fs: float | None = None) -> Transmissibility:
-    """Measured transmissibility from base and top responses of the same quantity (acceleration,
-    velocity or displacement: the ratio is the same), H1 = G_base,top / G_base,base with coherence.
+    """Measured transmissibility from base and top responses, with coherence, against a model.
 
-    With ``model`` (an object with ``transmissibility(freq)``, e.g. ``vm.models.SDOF``) the result
-    holds the model's |T|, and extras the largest deviation |measured/model - 1| over the lines where
-    coherence exceeds ``min_coherence`` and the base is excited (PSD within 30 dB of its median), and the model's isolation region (r = f/fn > sqrt(2)).
+    H1 = G_base,top / G_base,base; base and top must be the same quantity (the ratio is then the same for
+    acceleration, velocity or displacement).
+
+    Parameters
+    ----------
+    rec : Record
+        The record holding both channels.
+    base, top : str or int
+        The base (input) and top (output) channels.
+    model : object, optional
+        Anything with ``transmissibility(freq)`` (e.g. ``vm.models.SDOF``): its |T| is kept and the
+        largest deviation |measured / model - 1| where coherence exceeds ``min_coherence`` and the base
+        is excited goes to ``extras["max_deviation"]``.
+    nperseg : int, optional
+        Segment length of the cross-spectra.
+    min_coherence : float
+        Lines below it are left out of the comparison.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Transmissibility
+        ``freq``, ``t`` (complex), ``coherence``, ``isolation_hz`` and ``extras``.
+
+    Raises
+    ------
+    ParameterError
+        For unknown channels or base and top of different quantities.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> iso = vm.models.SDOF(m=1.0, k=3948.0, zeta=0.05)
+    >>> rec = vm.synth.base_excited(iso, fs=500.0, duration=60.0, seed=1)
+    >>> tr = vm.transmissibility(rec, base="base", top="top", model=iso)
+    >>> bool(abs(tr.isolation_hz - 10.0 * 2 ** 0.5) < 1.0)
+    True
     """
     from scipy.signal import csd, welch
     rec = as_record(rec, fs=fs)

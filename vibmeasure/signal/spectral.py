@@ -163,14 +163,55 @@ def psd(rec, *, nperseg: int | None = None, noverlap: int | None = None, window=
         fs: float | None = None, progress: Callable[[float], None] | None = None, dtype=None) -> Spectrum:
     """Welch power spectral density (or power spectrum) of every channel.
 
-    ``scaling="density"`` gives unit^2/Hz (energy-corrected with sum(w^2): Parseval holds, the
-    integral over frequency is the variance); ``"spectrum"`` gives unit^2 per line (amplitude-
-    corrected with sum(w)^2: a sine of amplitude A reads A^2/2). ``average`` "mean", "median"
-    (bias-corrected like scipy) or "max" (peak hold). Defaults: nperseg min(n, 4096), 50 % overlap,
-    Hann, constant detrend. ``rec`` may be a Record, a LazyRecord (streamed from disk) or an array
-    with ``fs``; ``progress(fraction)`` is called as blocks finish. ``dtype="float32"`` computes in
-    single precision (half the memory and FFT work; about 1e-6 relative error): use it for float32
-    recordings whose dynamic range is below about 120 dB. The default is float64.
+    ``scaling="density"`` gives unit^2/Hz (energy-corrected with sum(w^2): Parseval holds, the integral
+    over frequency is the variance); ``"spectrum"`` gives unit^2 per line (a sine of amplitude A reads
+    A^2/2). Equal to ``scipy.signal.welch`` to round-off, faster (docs/methods/spectra.md).
+
+    Parameters
+    ----------
+    rec : Record, LazyRecord or array_like
+        The record (a lazy record is streamed from disk; an array needs ``fs``).
+    nperseg : int, optional
+        Segment length (default min(n, 4096)).
+    noverlap : int, optional
+        Overlap (default nperseg // 2).
+    window : str, tuple or array_like
+        Window (default Hann).
+    detrend : {"constant", "linear", False}
+        What each segment loses first.
+    average : {"mean", "median", "max"}
+        Mean, median (bias-corrected like scipy) or peak hold.
+    scaling : {"density", "spectrum"}
+        Density or power per line.
+    nfft : int, optional
+        FFT length (zero-padding).
+    channels : str, int or list, optional
+        Channels to analyse (default all).
+    fs : float, optional
+        Sampling rate for an array.
+    progress : callable, optional
+        ``progress(fraction)`` as blocks finish.
+    dtype : {"float64", "float32"}, optional
+        float32 halves memory and FFT work (about 1e-6 relative error).
+
+    Returns
+    -------
+    Spectrum
+        Of kind "psd" (unit^2/Hz) or "power".
+
+    Raises
+    ------
+    ParameterError
+        For bad parameters, NaN or inf samples, or too short a record.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> rec = vm.Record.from_array(np.random.default_rng(1).normal(size=2 ** 14), fs=1000.0, unit="g")
+    >>> p = vm.psd(rec, nperseg=1024)
+    >>> round(float(np.sum(p.values[0]) * p.df), 1)   # the variance
+    1.0
     """
     src = _source(rec, fs, check=False)
     dtype = _check_dtype(dtype)
@@ -205,10 +246,52 @@ def amplitude_spectrum(rec, *, window="hann", nfft: int | None = None, scaling: 
                        progress: Callable[[float], None] | None = None) -> Spectrum:
     """Single-sided, amplitude-correct spectrum: a sine of amplitude A reads A at its frequency.
 
-    The window correction is computed from the actual window (2 / sum(w)), not from a table.
-    ``scaling`` "peak", "rms" (peak / sqrt 2) or "peak-to-peak". With ``nperseg`` the segments are
-    averaged in power ("mean", "median") or held ("max"); without it the whole record is one
-    segment (a lazy record defaults to 65536-sample segments). ``nfft`` zero-pads.
+    The window correction is computed from the actual window (2 / sum(w)), not from a table. With
+    ``nperseg`` the segments are averaged in power ("mean", "median") or held ("max"); without it the
+    whole record is one segment (a lazy record defaults to 65536-sample segments).
+
+    Parameters
+    ----------
+    rec : Record, LazyRecord or array_like
+        The record (an array needs ``fs``).
+    window : str, tuple or array_like
+        Window name ("hann", "flattop", ...), ("kaiser", beta) or the window's values.
+    nfft : int, optional
+        FFT length (zero-padding).
+    scaling : {"peak", "rms", "peak-to-peak"}
+        What a line reads for a sine.
+    nperseg, noverlap : int, optional
+        Segment length and overlap for averaging.
+    average : {"mean", "median", "max"}
+        How segments are combined.
+    detrend : {"constant", "linear", False}
+        What each segment loses first.
+    channels : str, int or list, optional
+        Channels to analyse (default all).
+    fs : float, optional
+        Sampling rate for an array.
+    progress : callable, optional
+        ``progress(fraction)`` as blocks finish.
+
+    Returns
+    -------
+    Spectrum
+        Of kind "amplitude", in the channels' unit.
+
+    Raises
+    ------
+    ParameterError
+        For bad parameters or data (NaN, inf, too short).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> t = np.arange(4096) / 1024.0
+    >>> rec = vm.Record.from_array(2.0 * np.sin(2 * np.pi * 100.0 * t), fs=1024.0, unit="g")
+    >>> spec = vm.amplitude_spectrum(rec)
+    >>> round(float(spec.values[0].max()), 3)
+    2.0
     """
     from ..io.lazy import LazyRecord
     src = _source(rec, fs)
@@ -247,7 +330,47 @@ def _pair_spectra(rec, x, y, nperseg, noverlap, window, detrend, nfft, fs, progr
 
 def csd(rec, x, y, *, nperseg: int | None = None, noverlap: int | None = None, window="hann",
         detrend="constant", nfft: int | None = None, fs: float | None = None, progress=None) -> Spectrum:
-    """Cross spectral density S_xy = E[conj(X) Y] (scipy's convention) between channels x and y."""
+    """Cross spectral density S_xy = E[conj(X) Y] (scipy's convention) between two channels.
+
+    Parameters
+    ----------
+    rec : Record, LazyRecord or array_like
+        The record.
+    x, y : str or int
+        The two channels.
+    nperseg, noverlap : int, optional
+        Segment length and overlap (defaults as ``psd``).
+    window : str, tuple or array_like
+        Window (default Hann).
+    detrend : {"constant", "linear", False}
+        What each segment loses first.
+    nfft : int, optional
+        FFT length.
+    fs : float, optional
+        Sampling rate for an array.
+    progress : callable, optional
+        ``progress(fraction)`` as blocks finish.
+
+    Returns
+    -------
+    Spectrum
+        Complex, of kind "csd".
+
+    Raises
+    ------
+    ParameterError
+        For unknown channels or bad parameters.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> x = np.random.default_rng(1).normal(size=8192)
+    >>> rec = vm.Record(np.vstack([x, 2 * x]), fs=1000.0, channels=[vm.Channel("f", "force", "N"), vm.Channel("a")])
+    >>> s = vm.csd(rec, "f", "a", nperseg=512)
+    >>> bool(np.allclose(s.values[0].imag, 0.0))
+    True
+    """
     src, ix, iy, autos, cross, nseg, p = _pair_spectra(rec, x, y, nperseg, noverlap, window, detrend, nfft, fs,
                                                         progress)
     cx, cy = src.channels[ix], src.channels[iy]
@@ -258,7 +381,46 @@ def csd(rec, x, y, *, nperseg: int | None = None, noverlap: int | None = None, w
 
 def coherence(rec, x, y, *, nperseg: int | None = None, noverlap: int | None = None, window="hann",
               detrend="constant", nfft: int | None = None, fs: float | None = None, progress=None) -> Spectrum:
-    """Magnitude-squared coherence |S_xy|^2 / (S_xx S_yy) between channels x and y (needs >= 2 averages)."""
+    """Magnitude-squared coherence |S_xy|^2 / (S_xx S_yy) between two channels (needs >= 2 averages).
+
+    Parameters
+    ----------
+    rec : Record, LazyRecord or array_like
+        The record.
+    x, y : str or int
+        The two channels.
+    nperseg, noverlap : int, optional
+        Segment length and overlap (defaults as ``psd``).
+    window : str, tuple or array_like
+        Window (default Hann).
+    detrend : {"constant", "linear", False}
+        What each segment loses first.
+    nfft : int, optional
+        FFT length.
+    fs : float, optional
+        Sampling rate for an array.
+    progress : callable, optional
+        ``progress(fraction)`` as blocks finish.
+
+    Returns
+    -------
+    Spectrum
+        Of kind "coherence", between 0 and 1.
+
+    Raises
+    ------
+    ParameterError
+        For unknown channels, bad parameters or a single average.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> x = np.random.default_rng(1).normal(size=8192)
+    >>> rec = vm.Record(np.vstack([x, 2 * x]), fs=1000.0, channels=[vm.Channel("f", "force", "N"), vm.Channel("a")])
+    >>> round(float(vm.coherence(rec, "f", "a", nperseg=512).values[0].min()), 6)
+    1.0
+    """
     src, ix, iy, autos, cross, nseg, p = _pair_spectra(rec, x, y, nperseg, noverlap, window, detrend, nfft, fs,
                                                         progress)
     if nseg < 2:
@@ -275,7 +437,43 @@ def coherence(rec, x, y, *, nperseg: int | None = None, noverlap: int | None = N
 @memory_guard
 def spectrogram(rec, *, channel=None, nperseg: int | None = None, noverlap: int | None = None, window="hann",
                 detrend="constant", nfft: int | None = None, fs: float | None = None) -> Spectrogram:
-    """Power spectral density of each segment over time (a waterfall): values (1, n_freq, n_times)."""
+    """Power spectral density of each segment over time (a waterfall).
+
+    Parameters
+    ----------
+    rec : Record, LazyRecord or array_like
+        The record.
+    channel : str or int, optional
+        The channel (default the first).
+    nperseg, noverlap : int, optional
+        Segment length and overlap.
+    window : str, tuple or array_like
+        Window (default Hann).
+    detrend : {"constant", "linear", False}
+        What each segment loses first.
+    nfft : int, optional
+        FFT length.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Spectrogram
+        ``values`` of shape (1, n_freq, n_times).
+
+    Raises
+    ------
+    ParameterError
+        For bad parameters or data.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> rec = vm.Record.from_array(np.random.default_rng(1).normal(size=4096), fs=1000.0)
+    >>> vm.spectrogram(rec, nperseg=256).values.shape[0]
+    1
+    """
     src = _source(rec, fs)
     nperseg, noverlap, nfft = check_segment_params(src.n_samples, nperseg, noverlap, nfft, detrend, "mean", 1024)
     idx = _channel_indices(src, 0 if channel is None else channel)
@@ -314,9 +512,39 @@ def _band_power(spec: Spectrum, lo: float, hi: float) -> np.ndarray:
 
 
 def band_rms(obj, band, *, fs: float | None = None, nperseg: int | None = None) -> np.ndarray:
-    """RMS of each channel in a frequency band (lo, hi) Hz, from its PSD (a Spectrum or a record).
+    """RMS of each channel in a frequency band, from its PSD.
 
-    Lines at the band edges count in part. ``band=(0, fs/2)`` gives the overall RMS less the mean.
+    Lines at the band edges count in part; ``band=(0, fs/2)`` gives the overall RMS less the mean.
+
+    Parameters
+    ----------
+    obj : Spectrum, Record or array_like
+        A PSD, or a record whose PSD is computed.
+    band : tuple of float
+        (lo, hi) in Hz.
+    fs : float, optional
+        Sampling rate for an array.
+    nperseg : int, optional
+        Segment length of the PSD computed from a record.
+
+    Returns
+    -------
+    numpy.ndarray
+        One RMS per channel, in the channels' unit.
+
+    Raises
+    ------
+    ParameterError
+        For a band outside (0, fs/2) or a spectrum that is no PSD.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> t = np.arange(2 ** 14) / 1000.0
+    >>> rec = vm.Record.from_array(np.sqrt(2) * np.sin(2 * np.pi * 50.0 * t), fs=1000.0)
+    >>> round(float(vm.band_rms(rec, (40, 60))[0]), 2)
+    1.0
     """
     spec = _as_density(obj, fs=fs, nperseg=nperseg)
     lo, hi = _check_band(band, spec.params.get("fs", 2 * spec.freq[-1]))
@@ -326,9 +554,37 @@ def band_rms(obj, band, *, fs: float | None = None, nperseg: int | None = None) 
 def octave_bands(obj, *, fraction: int = 3, band=None, fs: float | None = None, nperseg: int | None = None):
     """RMS in 1/1 or 1/3 octave bands (base-10 IEC 61260-1 mid-band frequencies), from the PSD.
 
-    Returns a pandas table: center_hz, lower_hz, upper_hz, lines (PSD lines inside the band: below 2
-    the band is narrower than the resolution) and one rms column per channel. Bands must lie
-    inside (df, fs/2) or ``band``.
+    Parameters
+    ----------
+    obj : Spectrum, Record or array_like
+        A PSD, or a record whose PSD is computed.
+    fraction : {1, 3}
+        Octave (1) or third-octave (3) bands.
+    band : tuple of float, optional
+        (lo, hi) Hz the bands must lie in (default (df, fs/2)).
+    fs : float, optional
+        Sampling rate for an array.
+    nperseg : int, optional
+        Segment length of the PSD computed from a record.
+
+    Returns
+    -------
+    pandas.DataFrame
+        center_hz, lower_hz, upper_hz, lines (PSD lines inside the band: below 2 the band is narrower
+        than the resolution) and one rms column per channel.
+
+    Raises
+    ------
+    ParameterError
+        For a fraction other than 1 or 3, or no band inside the range.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> rec = vm.Record.from_array(np.random.default_rng(1).normal(size=2 ** 14), fs=2000.0)
+    >>> "center_hz" in vm.octave_bands(rec, fraction=3).columns
+    True
     """
     import pandas as pd
     if fraction not in (1, 3):

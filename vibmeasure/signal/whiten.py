@@ -130,10 +130,37 @@ def prewhiten(rec, *, method: str = "cepstral", order: int | None = None, channe
               fs: float | None = None) -> Record:
     """One channel whitened before envelope analysis.
 
-    ``method="cepstral"`` divides the spectrum by its magnitude (cepstral pre-whitening);
-    ``method="ar"`` keeps the prediction error of a Yule-Walker AR model of ``order`` taps
-    (default: fs / 100, between 16 and 200). The result keeps the channel's name with a suffix;
-    its amplitude scale is arbitrary (unit "").
+    The result keeps the channel's name with a suffix; its amplitude scale is arbitrary (unit "").
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The record.
+    method : {"cepstral", "ar"}
+        Cepstral pre-whitening (the spectrum divided by its magnitude), or the prediction error of a
+        Yule-Walker AR model.
+    order : int, optional
+        AR order (default fs / 100, between 16 and 200).
+    channel : str or int, optional
+        The channel.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For an unknown method or bad data.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+    >>> vm.prewhiten(rec).channels[0].unit
+    ''
     """
     rec, i, x = _pick(rec, channel, fs)
     if method not in _METHODS:
@@ -151,9 +178,39 @@ def prewhiten(rec, *, method: str = "cepstral", order: int | None = None, channe
 
 
 def remove_synchronous(rec, *, shaft_hz: float, channel=None, fs: float | None = None) -> Record:
-    """The channel with its shaft-synchronous part (1X and every harmonic, gear mesh on that shaft)
-    removed: a time-synchronous average at the constant speed ``shaft_hz`` subtracted sample by sample.
-    What is left is the random and non-synchronous part, where bearing impacts live (they slip)."""
+    """The channel with its shaft-synchronous part (1X, its harmonics, a mesh on that shaft) removed.
+
+    A time-synchronous average at the constant speed ``shaft_hz`` is subtracted sample by sample; what
+    is left is the random and non-synchronous part, where bearing impacts live (they slip).
+
+    Parameters
+    ----------
+    rec : Record or array_like
+        The record.
+    shaft_hz : float
+        The shaft speed in Hz.
+    channel : str or int, optional
+        The channel.
+    fs : float, optional
+        Sampling rate for an array.
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For a speed outside (0, fs/2) or too short a record.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.machine(fault="unbalance", rpm=1800, duration=2.0, seed=1)
+    >>> rest = vm.remove_synchronous(rec, shaft_hz=30.0)
+    >>> bool(rest.data.std() < rec.data.std())
+    True
+    """
     rec, i, x = _pick(rec, channel, fs)
     f1 = positive(shaft_hz, "shaft_hz")
     if x.size / rec.fs * f1 < 10:

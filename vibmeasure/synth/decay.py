@@ -59,7 +59,30 @@ def _mode_signal(t, fn, zeta, amp, phase, order):
 
 
 def noise_std_for_snr(amplitude: float, snr_db: float) -> float:
-    """Noise std s giving SNR = A^2 / (2 s^2) (the initial sinusoid power over noise power)."""
+    """Noise std s giving SNR = A^2 / (2 s^2) (the initial sinusoid's power over the noise power).
+
+    Parameters
+    ----------
+    amplitude : float
+        The sinusoid's amplitude A.
+    snr_db : float
+        The signal-to-noise ratio in dB.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ParameterError
+        For an amplitude that is not positive.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> round(vm.synth.noise_std_for_snr(1.0, 40.0), 5)
+    0.00707
+    """
     return float(abs(amplitude) / np.sqrt(2 * 10 ** (snr_db / 10)))
 
 
@@ -86,13 +109,56 @@ def free_decay(*, fn, zeta, fs: float, duration: float, amplitude=1.0, phase=0.0
                unit: str | None = None, snr_db: float | None = None, noise_std: float | None = None,
                clip: float | None = None, dc_offset: float = 0.0, drift: float = 0.0, seed=None,
                name: str = "x") -> Record:
-    """Free decay of one or several viscously damped modes.
+    """Free decay of one or several viscously damped modes, with the sensor's imperfections.
 
     Each mode's displacement is ``amplitude * exp(-zeta wn t) cos(wd t + phase)`` (zeta < 1) or the
-    release from rest at ``amplitude`` (zeta >= 1); ``quantity`` "velocity"/"acceleration" records
-    its exact derivatives. ``snr_db`` sets white noise with SNR = A^2/(2 s^2), A the largest
-    initial envelope of the recorded quantity; ``clip`` clips at +-clip; ``dc_offset`` and
-    ``drift`` (units per second) model the sensor.
+    release from rest at ``amplitude`` (zeta >= 1); velocity and acceleration are its exact
+    derivatives. ``meta["truth"]`` holds the parameters.
+
+    Parameters
+    ----------
+    fn, zeta : float or array_like
+        Natural frequencies (Hz, undamped) and damping ratios.
+    fs : float
+        Sampling rate in Hz.
+    duration : float
+        Length in s.
+    amplitude, phase : float or array_like
+        Initial amplitude and phase (radians) per mode.
+    quantity : {"displacement", "velocity", "acceleration"}
+        What is recorded.
+    unit : str, optional
+        The unit label.
+    snr_db : float, optional
+        White noise with SNR = A^2 / (2 s^2), A the largest initial envelope.
+    noise_std : float, optional
+        Noise std instead of ``snr_db``.
+    clip : float, optional
+        Clip at +-clip.
+    dc_offset : float
+        Sensor offset.
+    drift : float
+        Sensor drift per second.
+    seed : int, optional
+        Random seed.
+    name : str
+        Channel name.
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For values out of range or mismatched lengths.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.free_decay(fn=[21.3, 57.9], zeta=[0.01, 0.02], fs=2000.0, duration=5.0, snr_db=40, seed=1)
+    >>> rec.meta["truth"]["fn"]
+    [21.3, 57.9]
     """
     fs = positive(fs, "fs")
     duration = positive(duration, "duration")
@@ -120,8 +186,47 @@ def coulomb_decay(*, fn: float, friction_decay: float, fs: float, duration: floa
                   noise_std: float | None = None, seed=None, name: str = "x") -> Record:
     """Free decay of a mass-spring system with dry (Coulomb) friction, released from rest.
 
-    The amplitude falls by ``friction_decay`` (= 4 F/k) every cycle, linearly in time, at the
-    undamped frequency ``fn``; the mass sticks once the amplitude is below F/k.
+    The amplitude falls by ``friction_decay`` (= 4 F/k) every cycle, linearly in time, at the undamped
+    frequency; the mass sticks once the amplitude is below F/k.
+
+    Parameters
+    ----------
+    fn : float
+        Undamped natural frequency in Hz.
+    friction_decay : float
+        Amplitude lost per cycle (4 F/k).
+    fs : float
+        Sampling rate in Hz.
+    duration : float
+        Length in s.
+    amplitude : float
+        Release amplitude.
+    quantity : {"displacement", "velocity", "acceleration"}
+        What is recorded.
+    unit : str, optional
+        The unit label.
+    snr_db, noise_std : float, optional
+        Noise, as for ``free_decay``.
+    seed : int, optional
+        Random seed.
+    name : str
+        Channel name.
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For values out of range.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.coulomb_decay(fn=4.2, friction_decay=4e-4, amplitude=5e-3, fs=500.0, duration=6.0)
+    >>> rec.fs
+    500.0
     """
     fn = positive(fn, "fn")
     fs = positive(fs, "fs")

@@ -14,16 +14,45 @@ def fleet(folder=None, *, n_measurements: int = 52, start: str = "2026-01-05", i
           fault_onset: int = 26, fs: float = 12800.0, duration: float = 1.0, seed: int = 0):
     """A small synthetic fleet measured over time, for tests, the sample data and the demo.
 
-    Four assets, one point each, measured every ``interval_days``: ``pump-1`` and ``pump-2``
-    healthy (rpm wandering by 1 %); ``pump-3`` whose bearing (6205-2RS) grows an outer-race defect from
-    measurement ``fault_onset`` on (BPFO impacts rising from nothing to twice the healthy RMS); and
-    ``frame-1``, a structure rung down at each visit, whose stiffness falls by up to 6 % from
-    ``fault_onset`` on (fn from 24 Hz down to about 23.3 Hz, noise 40 dB).
+    Four assets, one point each, measured every ``interval_days``: pump-1 and pump-2 healthy; pump-3
+    whose 6205-2RS grows an outer-race defect from measurement ``fault_onset`` on; frame-1, a
+    structure rung down at each visit whose stiffness falls by up to 6 %.
 
-    Returns a list of dicts (``record``, ``asset``, ``point``, ``time`` ISO 8601, ``rpm``, ``bearing``,
-    ``truth``). With ``folder`` each record is also written there as HDF5, with the manifests
-    ``machines.csv`` (task diagnose/spectrum) and ``structures.csv`` (task ringdown+compare) for
-    ``vm.batch`` / ``vibmeasure batch``.
+    Parameters
+    ----------
+    folder : str or os.PathLike, optional
+        Write each record there as HDF5, with the manifests machines.csv and structures.csv.
+    n_measurements : int
+        Measurements per asset.
+    start : str
+        Date of the first measurement (ISO 8601).
+    interval_days : float
+        Days between measurements.
+    fault_onset : int
+        Measurement at which the faults begin.
+    fs : float
+        Sampling rate of the machines in Hz.
+    duration : float
+        Length of each machine record in s.
+    seed : int
+        Random seed.
+
+    Returns
+    -------
+    list of dict
+        record, asset, point, time (ISO 8601), rpm, bearing, truth.
+
+    Raises
+    ------
+    ParameterError
+        For values out of range.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> items = vm.synth.fleet(n_measurements=2)
+    >>> sorted({i["asset"] for i in items})
+    ['frame-1', 'pump-1', 'pump-2', 'pump-3']
     """
     import datetime as _dt
     from pathlib import Path

@@ -48,20 +48,58 @@ def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: f
     """Accelerometer record of a rotating machine, healthy or with one fault, for tests and demos.
 
     Every machine has a small residual 1X and broadband noise. Faults: unbalance (strong 1X),
-    misalignment (strong 2X beside 1X), looseness (many harmonics and 0.5X sub-harmonics), bearing
-    defects (impacts at BPFO/BPFI/BSF with 1 % slip jitter exciting a structural resonance; inner
-    race and ball faults amplitude-modulated at 1X and FTF), gear mesh (teeth x 1X with 1X
-    sidebands), resonance (a structural mode 6 % above 1X amplifying 1X and the broadband forces). ``severity`` scales the fault, ``snr_db`` is the fault signal's power over the noise.
-    Nuisances that are no fault (stress cases for the diagnosis): ``cage_modulation`` (0..1) modulates
-    the broadband noise at the cage rate FTF and its harmonics, as an uneven cage or load does on a
-    healthy bearing; ``shaft_impacts`` (relative to the fault signal's RMS, or to 0.3 g without a
-    fault) adds one impact per revolution exciting the resonance (a rub): its envelope is a comb of
-    shaft harmonics. The fault-free part is in g; meta holds rpm and the truth.
+    misalignment (2X beside 1X), looseness (harmonics and 0.5X sub-harmonics), bearing defects
+    (impacts at BPFO/BPFI/2 x BSF with 1 % slip jitter ringing a resonance; inner race and ball faults
+    modulated at 1X and FTF), gear mesh (teeth x 1X with 1X sidebands), resonance (a mode 6 % above 1X).
+    ``meta`` holds rpm and the truth.
 
-    ``rpm=(start, end)`` runs the shaft up (or down) linearly over the record: every shaft-, gear- and
-    bearing-rate event then follows the shaft angle, while the structural resonances stay put in Hz;
-    meta["rpm"] is the mean speed. ``tach=N`` adds a channel "tach" with N pulses (0 -> 5 V) per
-    revolution, as a tachometer or encoder gives.
+    Parameters
+    ----------
+    fault : str
+        "none", "unbalance", "misalignment", "looseness", "bearing_outer_race", "bearing_inner_race",
+        "bearing_ball", "gear_mesh" or "resonance".
+    rpm : float or tuple of float
+        Shaft speed, or (start, end) for a linear run-up (events follow the shaft angle).
+    fs : float
+        Sampling rate in Hz.
+    duration : float
+        Length in s.
+    severity : float
+        Scales the fault.
+    snr_db : float
+        The fault's power over the noise.
+    bearing : str or Bearing, optional
+        The bearing (default 6205-2RS).
+    gear_teeth : int
+        Teeth of the gear (gear_mesh).
+    resonance_hz : float
+        The structural resonance the impacts ring.
+    cage_modulation : float
+        0..1: the noise modulated at the cage rate (a stress case: no fault).
+    shaft_impacts : float
+        One impact per revolution (a rub), relative to the fault's RMS.
+    seed : int, optional
+        Random seed.
+    unit : str
+        The acceleration's unit.
+    tach : int
+        Add a channel "tach" with this many pulses per revolution (0: none).
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For an unknown fault or values out of range.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.machine(fault="bearing_outer_race", rpm=1797, duration=2.0, seed=1)
+    >>> rec.meta["rpm"], rec.names
+    (1797.0, ['acc'])
     """
     from ..models.bearing import BEARINGS, Bearing
     if fault not in _FAULTS:
@@ -230,12 +268,46 @@ def _machine_record(x, shaft: _Shaft, fault, severity, snr_db, unit, tach) -> Re
 
 def cage_pulsing(*, fs: float, duration: float, rpm: float = 1797.0, bearing="6205-2RS", width: float = 1 / 15,
                  band=(2500.0, 4500.0), seed=None) -> np.ndarray:
-    """Unit-RMS noise in ``band`` (Hz) whose level pulses once per turn of the bearing's cage: the
-    Gaussian pulse exp(-(2 pi t / width)^2 / 2) over the turn's phase t (-0.5..0.5), four times the
-    floor at its peak. Its envelope is a comb of FTF harmonics falling as exp(-(k width)^2 / 2), 0.83 at
-    the 9th and 0.49 at the 18th for the default width: a cage comb of many harmonics, which carries
-    lines where BPFO (n_balls x FTF) and, on most geometries, BPFI or 2 x BSF fall. Added to a machine
-    (``machine``), a stress case for the diagnosis: an uneven cage or load on a healthy bearing."""
+    """Unit-RMS noise in a band whose level pulses once per turn of the bearing's cage.
+
+    The Gaussian pulse exp(-(2 pi t / width)^2 / 2) over the turn's phase t (-0.5..0.5), four times
+    the floor at its peak: its envelope is a comb of FTF harmonics (0.83 at the 9th and 0.49 at the 18th
+    for the default width), which carries lines where BPFO and, on most geometries, BPFI or 2 x BSF
+    fall. Added to a machine, a stress case for the diagnosis: an uneven cage on a healthy bearing.
+
+    Parameters
+    ----------
+    fs : float
+        Sampling rate in Hz.
+    duration : float
+        Length in s.
+    rpm : float
+        Shaft speed.
+    bearing : str or Bearing
+        The bearing.
+    width : float
+        Pulse width as a share of a cage turn.
+    band : tuple of float
+        (lo, hi) Hz of the noise.
+    seed : int, optional
+        Random seed.
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Raises
+    ------
+    ParameterError
+        For a band outside (0, fs/2), a record shorter than one cage turn, or a bad seed.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> x = vm.synth.cage_pulsing(fs=12000.0, duration=2.0, seed=1)
+    >>> round(float(x.std()), 2)
+    1.0
+    """
     from scipy.signal import butter, sosfiltfilt
 
     from ..models.bearing import bearing_from

@@ -28,7 +28,37 @@ def modal_frf(freq, *, fn, zeta, shapes, input_dof: int = 0, form: str = "recept
     """Analytic FRFs of a proportionally damped system from its modes (a closed-form oracle).
 
     H_p,in(w) = sum_r phi_pr phi_in,r / (w_r^2 - w^2 + 2 i zeta_r w_r w) (receptance), times i w or
-    -w^2 for mobility or accelerance. ``shapes`` (n_dof, n_modes) mass-normalised.
+    -w^2 for mobility or accelerance.
+
+    Parameters
+    ----------
+    freq : array_like
+        Frequency lines in Hz.
+    fn, zeta : array_like
+        The modes.
+    shapes : array_like
+        Mass-normalised shapes (n_dof, n_modes).
+    input_dof : int
+        The driven dof.
+    form : {"receptance", "mobility", "accelerance"}
+        The FRF form.
+
+    Returns
+    -------
+    FRF
+
+    Raises
+    ------
+    ParameterError
+        For shapes that do not match the modes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> h = vm.synth.modal_frf(np.linspace(1, 100, 100), fn=[30.0], zeta=[0.02], shapes=[[1.0]])
+    >>> h.h.shape
+    (1, 1, 100)
     """
     from ..core.results import FRF
     freq = np.asarray(freq, float)
@@ -44,10 +74,42 @@ def modal_frf(freq, *, fn, zeta, shapes, input_dof: int = 0, form: str = "recept
 
 
 def modal_response(force, *, fs: float, fn, zeta, shapes, input_dof: int = 0, quantity: str = "displacement"):
-    """Responses (n_dof, n) of a proportionally damped system to a force sampled at ``fs``.
+    """Responses of a proportionally damped system to a force sampled at ``fs``.
 
     Each mode is discretised exactly for a force held between samples (zero-order hold), so the
-    discrete poles are exp(lambda_r / fs) exactly; outputs sum phi_pr q_r (or its derivatives).
+    discrete poles are exp(lambda_r / fs) exactly.
+
+    Parameters
+    ----------
+    force : array_like
+        Force samples in N.
+    fs : float
+        Sampling rate in Hz.
+    fn, zeta : array_like
+        The modes.
+    shapes : array_like
+        Mass-normalised shapes (n_dof, n_modes).
+    input_dof : int
+        The driven dof.
+    quantity : {"displacement", "velocity", "acceleration"}
+        What is returned.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_dof, n_samples).
+
+    Raises
+    ------
+    ParameterError
+        For shapes that do not match the modes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> vm.synth.modal_response(np.ones(100), fs=1000.0, fn=[10.0], zeta=[0.02], shapes=[[1.0], [0.5]]).shape
+    (2, 100)
     """
     from scipy.signal import cont2discrete, lfilter
     force = np.asarray(force, float)
@@ -69,11 +131,52 @@ def hammer_test(*, fn, zeta, shapes, fs: float, hits=(0.2, 2.2, 4.2), duration: 
                 peak_force: float = 100.0, width: float = 0.003, double_at: float | None = None,
                 input_dof: int = 0, quantity: str = "acceleration", noise: float = 1e-4, force_noise: float = 0.05,
                 seed=None) -> Record:
-    """A hammer test: half-sine force pulses (``peak_force`` N, ``width`` s) at the ``hits`` times
-    (s) on ``input_dof`` and the responses of every dof of a proportionally damped system, each
-    mode discretised exactly. ``double_at`` adds a second, weaker pulse (a double hit). Response
-    noise is ``noise`` times each channel's std; the force gets ``force_noise`` N of noise.
-    Channels: ``hammer`` (force, N) and ``a0``, ``a1``, ... (``quantity`` in SI units).
+    """A hammer test: half-sine force pulses at the ``hits`` times and the responses of every dof.
+
+    Parameters
+    ----------
+    fn, zeta : array_like
+        The modes.
+    shapes : array_like
+        Mass-normalised shapes (n_dof, n_modes).
+    fs : float
+        Sampling rate in Hz.
+    hits : sequence of float
+        Times of the hits in s.
+    duration : float, optional
+        Length in s (default 2 s after the last hit).
+    peak_force : float
+        Peak force in N.
+    width : float
+        Pulse width in s.
+    double_at : float, optional
+        Delay of a second, weaker pulse after each hit (a double hit).
+    input_dof : int
+        The hit dof.
+    quantity : {"displacement", "velocity", "acceleration"}
+        What the responses record.
+    noise : float
+        Response noise as a share of each channel's std.
+    force_noise : float
+        Force noise std in N.
+    seed : int, optional
+        Random seed.
+
+    Returns
+    -------
+    Record
+        Channels ``hammer`` (force, N) and ``a0``, ``a1``, ...
+
+    Raises
+    ------
+    ParameterError
+        For hits outside the record or shapes that do not match.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> vm.synth.hammer_test(fn=[21.3], zeta=[0.01], shapes=[[1.0]], fs=1024.0, seed=1).names
+    ['hammer', 'a0']
     """
     fs = positive(fs, "fs")
     hits = np.atleast_1d(np.asarray(hits, float))
@@ -108,17 +211,49 @@ def hammer_test(*, fn, zeta, shapes, fs: float, hits=(0.2, 2.2, 4.2), duration: 
 
 def ambient(model, *, fs: float, duration: float, outputs=None, inputs=None, quantity: str = "acceleration",
             noise: float = 0.05, force_std: float = 1.0, seed=None) -> Record:
-    """Response of an MDOF model (``vm.models.MDOF``) to broadband random forces: operational (ambient)
-    vibration with known modes, for output-only modal analysis.
+    """Response of an MDOF model to broadband random forces: operational vibration with known modes.
 
-    Independent white Gaussian forces (std ``force_std`` N, held between samples) act at the dofs
-    ``inputs`` (default all); the ``outputs`` dofs (default all) are recorded as ``quantity``. The
-    state-space model is diagonalised and each complex mode discretised exactly for the held force,
-    so the record's discrete poles are exp(lambda / fs) exactly. A warm-up of five time constants of
-    the slowest-decaying mode is simulated and dropped, so the record is stationary from its start.
-    ``outputs`` may also be a matrix (n_sensors, n_dof): each row a sensor reading a combination of
-    dofs (a sensor between two masses, or a second sensor on one dof). ``noise`` is the output noise std as a fraction of each output's RMS (0.05: 5 %).
-    ``meta["truth"]`` holds fn, zeta and the mode shapes at the outputs (the model's ``modes()``).
+    Independent white Gaussian forces (held between samples) act at ``inputs``; each complex mode is
+    discretised exactly, and a warm-up of five time constants is dropped, so the record is stationary.
+    ``meta["truth"]`` holds fn, zeta and the shapes at the outputs.
+
+    Parameters
+    ----------
+    model : MDOF
+        The structure.
+    fs : float
+        Sampling rate in Hz.
+    duration : float
+        Length in s.
+    outputs : sequence of int or array_like, optional
+        Recorded dofs (default all), or a (n_sensors, n_dof) matrix of sensor combinations.
+    inputs : sequence of int, optional
+        Excited dofs (default all).
+    quantity : {"displacement", "velocity", "acceleration"}
+        What is recorded.
+    noise : float
+        Output noise std as a share of each output's RMS.
+    force_std : float
+        Std of each force in N.
+    seed : int, optional
+        Random seed.
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For an unknown dof or values out of range.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> chain = vm.models.MDOF(np.eye(2), np.array([[2e4, -1e4], [-1e4, 1e4]]), modal_zeta=[0.02, 0.02])
+    >>> vm.synth.ambient(chain, fs=100.0, duration=60.0, seed=1).n_channels
+    2
     """
     from scipy.signal import lfilter
 
@@ -197,12 +332,42 @@ def _sensors(outputs, n):
 
 def base_excited(model, *, fs: float, duration: float, bandwidth: float | None = None, noise: float = 0.0,
                  seed=None) -> Record:
-    """A base-excited SDOF (``vm.models.SDOF``) measured at its base and on its mass: random base
-    acceleration (Gaussian, flat up to ``bandwidth`` Hz, default fs/4) and the mass's absolute
-    acceleration. The record is one period of a periodic random signal built in the frequency
-    domain, and the response is the model's complex transmissibility applied line by line: the exact
-    steady state, with no discretisation error. Channels "base" and "top" (m/s^2); ``noise`` is the
-    sensor noise std as a fraction of each channel's RMS."""
+    """A base-excited SDOF measured at its base and on its mass.
+
+    Random base acceleration (flat up to ``bandwidth``) as one period of a periodic random signal, and
+    the mass's absolute acceleration from the model's complex transmissibility line by line: the exact
+    steady state. Channels "base" and "top" (m/s^2).
+
+    Parameters
+    ----------
+    model : SDOF
+        The isolator.
+    fs : float
+        Sampling rate in Hz.
+    duration : float
+        Length in s.
+    bandwidth : float, optional
+        Highest excited frequency (default fs/4).
+    noise : float
+        Sensor noise std as a share of each channel's RMS.
+    seed : int, optional
+        Random seed.
+
+    Returns
+    -------
+    Record
+
+    Raises
+    ------
+    ParameterError
+        For values out of range.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> vm.synth.base_excited(vm.models.SDOF(m=1.0, k=3948.0, zeta=0.05), fs=500.0, duration=10.0, seed=1).names
+    ['base', 'top']
+    """
     from ..models.sdof import SDOF
     if not isinstance(model, SDOF):
         raise ParameterError(f"model must be a vm.models.SDOF, got {type(model).__name__}")

@@ -207,24 +207,51 @@ def oma_fdd(rec, *, band, nperseg: int | None = None, channels=None, n_modes: in
             min_prominence_db: float = 6.0, mac_bell: float = 0.8) -> ModalEstimate:
     """Modes from output-only data by frequency-domain decomposition, damping by EFDD.
 
-    The cross-spectral matrix of the outputs (Hann, 50 % overlap, ``nperseg`` samples per segment)
-    is decomposed by SVD at every line. Peak rule: a peak of the first (or, for close modes, the
-    second) singular value in ``band`` is a mode when it stands ``min_prominence_db`` above its
-    surroundings, its singular vector is coherent around it (MAC >= 0.9 two lines either side) and
-    its band is a random response, not a harmonic (band kurtosis >= 2.2; a sinusoid gives 1.5);
-    ``n_modes`` keeps the most prominent. EFDD: the lines around each peak whose singular vector matches the peak's (MAC >=
-    ``mac_bell``) form the mode's SDOF bell; its inverse transform, corrected for the window, is the
-    mode's correlation function (a free decay), fitted by ``vm.ringdown`` for fn and zeta; the bias
-    that cutting the bell leaves is found by the same cut and fit on the exact SDOF bell at the
-    estimate and removed (``extras["bells"][k]["bias_removed_zeta"]``; a mode whose bias would exceed
-    half its zeta, or cannot be found, keeps the plain fit and is flagged ``bias_uncorrected``).
-    Their stds come from a jackknife over 8 groups of segments (each left out, the decomposition and
-    EFDD repeated; the ring-down fit's own std where larger), or the ring-down fit's std alone (a
-    lower bound: it takes the correlation function's errors as white) when the record has fewer than
-    16 segments. A peak whose correlation function does not decay (a stationary tone) or whose
-    damping's relative std exceeds 0.3 (the limit of oma_ssi, ringdown and fit_modes) is not a mode:
-    it goes to ``extras["rejected_peaks"]`` with the reason, and FitError lists them all when no mode
-    is left. Shapes are the singular vectors at the peaks.
+    The outputs' cross-spectral matrix is decomposed by SVD at every line; a peak of the first (or, for
+    close modes, the second) singular value is a mode when it stands ``min_prominence_db`` above its
+    surroundings, its singular vector is coherent around it and its band is a random response. EFDD
+    takes each mode's bell (lines whose singular vector matches, MAC >= ``mac_bell``) back to a free
+    decay, fitted by ``vm.ringdown``, with the bias of cutting the bell removed; stds from a jackknife
+    over segment groups. Refused peaks are in ``extras["rejected_peaks"]`` (docs/methods/oma.md).
+
+    Parameters
+    ----------
+    rec : Record
+        Responses of one or more sensors.
+    band : tuple of float
+        (lo, hi) Hz.
+    nperseg : int, optional
+        Segment length of the cross-spectra.
+    channels : list, optional
+        Output channels (default every channel that is not a force).
+    n_modes : int, optional
+        Keep the most prominent.
+    min_prominence_db : float
+        How far a peak must stand above its surroundings.
+    mac_bell : float
+        MAC a line's singular vector needs with the peak's to belong to its bell.
+
+    Returns
+    -------
+    ModalEstimate
+        fn, zeta, stds and shapes (the singular vectors at the peaks).
+
+    Raises
+    ------
+    ParameterError
+        For bad parameters or too short a record.
+    FitError
+        When no mode is left (every refused peak listed).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> chain = vm.models.MDOF(np.eye(2), np.array([[2e4, -1e4], [-1e4, 1e4]]), modal_zeta=[0.02, 0.02])
+    >>> amb = vm.synth.ambient(chain, fs=100.0, duration=300.0, noise=0.05, seed=1)
+    >>> est = vm.oma_fdd(amb, band=(1, 40))
+    >>> est.n_modes
+    2
     """
     Y, names = _outputs(rec, channels, "oma_fdd", 1)
     try:

@@ -16,7 +16,33 @@ ISO_SCOPE_RPM = (120.0, 15000.0)
 
 
 def severity_zone(v_rms_mm_s: float, *, group: int = 2, foundation: str = "rigid") -> str:
-    """ISO 10816-3 zone A/B/C/D of an overall velocity RMS (mm/s) for a machine group and foundation."""
+    """ISO 10816-3 zone of an overall velocity RMS for a machine group and foundation.
+
+    Parameters
+    ----------
+    v_rms_mm_s : float
+        Velocity RMS in mm/s over the standard's band (10-1000 Hz; 2-1000 Hz below 600 rpm).
+    group : {1, 2}
+        Group 1: large machines (300 kW - 50 MW); group 2: medium machines (15 - 300 kW).
+    foundation : {"rigid", "flexible"}
+        Rigid when the lowest support mode lies above the running speed.
+
+    Returns
+    -------
+    str
+        "A", "B", "C" or "D".
+
+    Raises
+    ------
+    ParameterError
+        For a group or foundation the standard does not define.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> vm.severity_zone(3.2, group=2, foundation="rigid")
+    'C'
+    """
     key = (int(group), foundation)
     if key not in ISO_10816_3:
         raise ParameterError(f"machine_group={group!r}, foundation={foundation!r}: group 1 or 2, rigid or flexible")

@@ -34,43 +34,68 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
              fs: float | None = None, tach=None, pulses_per_rev: int = 1, rpm_profile=None) -> Diagnosis:
     """Diagnose a rotating machine from an acceleration record.
 
-    ``rpm`` is the declared shaft speed (default: the record's meta["rpm"]); ``bearing`` a vm.Bearing
-    or a catalogue name (``vm.BEARINGS``: "6205-2RS", "6203", "6308-2Z C3", "MFPT", ...; a roller
-    bearing, which the catalogue does not hold, as vm.Bearing from the maker's data); ``gear`` a tooth count
-    or vm.Gear; ``machine_group`` (1 or 2) and ``foundation`` ("rigid", "flexible") select the ISO
-    10816-3 zones (default group 2, rigid). ``channel`` is the channel for speed, severity and shaft
-    orders (default the first that is not a force); bearing faults are searched in every channel
-    (``channels=`` restricts them) and the result names the one carrying the evidence. ``band`` fixes
-    the demodulation band (default: whole band, fast kurtogram and infogram bands); ``prewhitening``
-    names the pre-processings searched: "cepstral" (default) and/or "ar" (shaft-synchronous part and
-    discrete lines removed, then AR whitening). ``line_frequency``
-    (50 or 60 Hz) adds the electrical check at twice the line frequency; lines at the line frequency
-    (default: 50 and 60 Hz) or twice it are mains, not taken for the 1X or for another shaft.
+    The steps (docs/methods/diagnosis.md): every channel checked for the recording chain's damage
+    (spikes and dropouts filled, transients gated, saturation flagged); the running speed from the 1X
+    near ``rpm`` (within 12 %), checked against fs and against shaft or bearing combs that stand where
+    another speed puts them (flag ``speed_contradicted``: then no fault is looked for); the supply's
+    lines set aside; the ISO 10816-3 severity; shaft-order faults weighed by the level; bearing
+    families as a statistical test on pre-whitened squared-envelope spectra of every channel; the
+    decision with a calibrated confidence and its reason. A speed that varies (``tach``,
+    ``rpm_profile``, or a 1X that drifts) is followed by order tracking (flag ``order_tracked``).
 
-    A speed that varies over the record: give ``tach`` (the tachometer or encoder channel, by name or
-    index, or its samples; ``pulses_per_rev`` pulses per revolution) or ``rpm_profile`` (one rpm per
-    sample). ``rpm`` then defaults to the mean speed. When the mean speeds of up to 8 parts of the
-    record differ by more than ``VARYING_SPEED`` (0.2 %), every channel is resampled at equal steps
-    of shaft angle and the shaft-order and bearing analyses run in orders (cepstral pre-whitening
-    after order tracking: Borghesani et al. 2013); frequencies are then orders x the mean speed, flag
-    ``order_tracked``. Without speed information, a 1X that drifts along a curve (flag
-    ``speed_varies``) gives the speed profile instead (``speed["source"]`` "1X line"). The ISO
-    severity is taken from the record as measured.
+    Parameters
+    ----------
+    rec : Record or array_like
+        Acceleration channels (an array needs ``fs``); a tachometer channel may ride along.
+    rpm : float, optional
+        Declared shaft speed (default the record's meta["rpm"], or the tachometer's mean).
+    bearing : str or Bearing, optional
+        A catalogue name (``vm.BEARINGS``: "6205-2RS", "6203-2RS", "MFPT", ...) or a vm.Bearing; without
+        it bearing faults are not checked.
+    gear : int or Gear, optional
+        Teeth of a gear on the shaft.
+    machine_group : {1, 2}, optional
+        ISO 10816-3 group (default 2).
+    foundation : {"rigid", "flexible"}, optional
+        ISO 10816-3 support class (default rigid).
+    channel : str or int, optional
+        The channel for speed, severity and shaft orders (default the first that is not a force).
+    channels : str, int or list, optional
+        The channels searched for bearing faults (default every vibration channel).
+    band : tuple of float, optional
+        A fixed demodulation band (Hz); default the whole band, the kurtogram's and the infogram's.
+    prewhitening : str or tuple of str
+        "cepstral" (default) and/or "ar".
+    line_frequency : float, optional
+        The supply's frequency (50 or 60 Hz): adds the electrical check at twice it.
+    fs : float, optional
+        Sampling rate for an array.
+    tach : str, int or array_like, optional
+        Tachometer or encoder channel (or its samples): the speed is measured.
+    pulses_per_rev : int
+        Tachometer pulses per revolution.
+    rpm_profile : array_like, optional
+        One rpm per sample, instead of a tachometer.
 
-    Every channel is checked for the recording chain's damage first (``signal.quality``): isolated
-    spikes and dropouts are filled by AR interpolation (flags ``spikes_removed``, ``dropouts``; spikes
-    at a fixed interval of P samples also have the comb at fs / P claimed in the envelope spectra),
-    saturation is flagged (``saturated``); ``extras["data_quality"]`` holds the findings
-    per channel, and a QualityWarning names them.
+    Returns
+    -------
+    Diagnosis
+        ``top``, ``confidence``, ``reason``, ``faults`` (one row per family), ``speed``, ``severity``,
+        ``channel``, ``flags`` and ``extras`` (the material for ``plot_diagnosis``).
 
-    The 1X is looked for within 12 % of ``rpm``. When the record contradicts the declared speed (a
-    shaft comb stands elsewhere, 10 dB above the 1X candidate and with more harmonics, in any channel),
-    the flag is ``speed_contradicted``, ``speed["contradicting_rpm"]`` says where the comb stands, and
-    no shaft-order or bearing fault is looked for ("none", ``bearing_checked`` False). Where no 1X line
-    confirms the declared speed, the bearing's own lines can contradict it too: a fault comb that
-    stands where another speed (0.5-2 x) puts it, far stronger than any at the declared speed
-    (``bearing.decoys._speed_scan``; ``speed["contradicted_by"]`` is then "bearing lines" and
-    ``speed["bearing_comb"]`` holds the comb).
+    Raises
+    ------
+    ParameterError
+        For a missing speed, fs too low for the bearing's lines, too few revolutions, bad options or
+        a channel with nothing to analyse.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.machine(fault="bearing_inner_race", rpm=1797, duration=4.0, seed=1)
+    >>> d = vm.diagnose(rec, rpm=1797, bearing="6205-2RS")
+    >>> d.top, d.confidence > 0.9
+    ('bearing_inner_race', True)
     """
     rec = as_record(rec, fs=fs)
     tracked = _tracked_speed(rec, tach, rpm_profile, pulses_per_rev)
