@@ -15,9 +15,34 @@ __all__ = ["Bearing", "Gear", "BEARINGS", "bearing_from"]
 
 @dataclass(frozen=True)
 class Bearing:
-    """Geometry: number of rolling elements, ball and pitch diameters (any one length unit) and the
-    contact angle in degrees. ``frequencies(shaft_hz)`` gives BPFO, BPFI, BSF, 2xBSF and FTF in Hz
-    (outer race fixed, inner race turning with the shaft)."""
+    """A rolling-element bearing's geometry (outer race fixed, inner race turning with the shaft).
+
+    Parameters
+    ----------
+    n_balls : int
+        Number of rolling elements.
+    ball_diameter : float
+        Ball (roller) diameter, in any length unit.
+    pitch_diameter : float
+        Pitch diameter, in the same unit.
+    contact_angle : float
+        Contact angle in degrees.
+    name : str
+        A label (catalogue bearings carry their designation).
+
+    Raises
+    ------
+    ParameterError
+        For a geometry that cannot turn (ball larger than the pitch, fewer than 3 balls).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> b = vm.Bearing(9, 0.3126, 1.537, 0.0)
+    >>> round(float(b.frequencies(1797 / 60)["BPFO"]), 1)
+    107.4
+    """
 
     n_balls: int
     ball_diameter: float
@@ -35,21 +60,82 @@ class Bearing:
             raise ParameterError(f"contact_angle={self.contact_angle} must be in [0, 90) degrees")
 
     def orders(self) -> dict:
-        """Fault frequencies as multiples of the shaft speed."""
+        """Fault frequencies as multiples of the shaft speed.
+
+        Returns
+        -------
+        dict
+            BPFO, BPFI, BSF, 2xBSF, FTF in orders.
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid bearing.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> round(float(vm.BEARINGS["6205-2RS"].orders()["BPFO"]), 3)
+        3.585
+        """
         r = self.ball_diameter / self.pitch_diameter * np.cos(np.radians(self.contact_angle))
         n = self.n_balls
         bsf = self.pitch_diameter / (2 * self.ball_diameter) * (1 - r ** 2)
         return {"BPFO": n / 2 * (1 - r), "BPFI": n / 2 * (1 + r), "BSF": bsf, "2xBSF": 2 * bsf, "FTF": (1 - r) / 2}
 
     def frequencies(self, shaft_hz: float) -> dict:
+        """Fault frequencies in Hz at a shaft speed.
+
+        Parameters
+        ----------
+        shaft_hz : float
+            Shaft speed in Hz.
+
+        Returns
+        -------
+        dict
+            BPFO, BPFI, BSF, 2xBSF, FTF in Hz.
+
+        Raises
+        ------
+        ParameterError
+            For a speed that is not positive.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> sorted(vm.BEARINGS["6205-2RS"].frequencies(30.0))
+        ['2xBSF', 'BPFI', 'BPFO', 'BSF', 'FTF']
+        """
         f = positive(shaft_hz, "shaft_hz")
         return {k: v * f for k, v in self.orders().items()}
 
 
 @dataclass(frozen=True)
 class Gear:
-    """A gear on the measured shaft: ``teeth``; mesh frequency teeth x shaft speed, with sidebands at
-    the shaft speed (and at ``mating_shaft_ratio`` x shaft speed for the mating gear, if given)."""
+    """A gear on the measured shaft: mesh frequency teeth x shaft speed, sidebands at the shaft speed.
+
+    Parameters
+    ----------
+    teeth : int
+        Number of teeth.
+    mating_shaft_ratio : float, optional
+        The mating shaft's speed over this shaft's (its sidebands).
+
+    Raises
+    ------
+    ParameterError
+        For fewer than one tooth or a ratio that is not positive.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> vm.Gear(32).teeth
+    32
+    """
 
     teeth: int
     mating_shaft_ratio: float | None = None

@@ -91,7 +91,33 @@ def _depth(v, limit: int, level: int = 0) -> int:
 
 
 def load(path) -> object:
-    """A model from a TOML file (see the module docstring for the format)."""
+    """A model from a TOML file: every parameter with its unit (``vibmeasure model --help`` prints the format).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The TOML file.
+
+    Returns
+    -------
+    SDOF, MDOF, Beam, Rod, Shaft or String
+
+    Raises
+    ------
+    ParameterError
+        For a missing file, invalid TOML, an unknown type, or a parameter without its unit.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "beam.toml"
+    >>> _ = p.write_text(chr(10).join(['type = "sdof"', '[parameters]', 'm = "1.2 kg"', 'k = "26.6 kN/m"',
+    ...                                'zeta = 0.012', '']))
+    >>> round(vm.models.load(p).fn, 1)
+    23.7
+    """
     import tomllib
     from .continua import Beam, Rod, Shaft, String
     from .mdof import MDOF

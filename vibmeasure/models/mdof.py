@@ -31,7 +31,34 @@ def _spd(A, name):
 
 
 class MDOF:
-    """M (kg), K (N/m) and damping: C (N s/m), rayleigh=(alpha, beta) or modal_zeta (one per mode)."""
+    """A multi-degree-of-freedom system M x'' + C x' + K x = f.
+
+    Parameters
+    ----------
+    M : array_like
+        Mass matrix in kg (symmetric, positive definite).
+    K : array_like
+        Stiffness matrix in N/m (symmetric).
+    C : array_like, optional
+        Damping matrix in N s/m.
+    rayleigh : tuple of float, optional
+        (alpha, beta): C = alpha M + beta K.
+    modal_zeta : array_like, optional
+        One damping ratio per mode (classical damping).
+
+    Raises
+    ------
+    ParameterError
+        For matrices of different shapes, not symmetric, or a mass matrix that is not positive definite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> chain = vm.models.MDOF(np.eye(2), np.array([[2e4, -1e4], [-1e4, 1e4]]), modal_zeta=[0.02, 0.02])
+    >>> np.round(chain.modes().fn, 2).tolist()
+    [9.84, 25.75]
+    """
 
     def __init__(self, M, K, C=None, *, rayleigh=None, modal_zeta=None):
         self.M = _spd(M, "M")
@@ -84,18 +111,72 @@ class MDOF:
         return self.M.shape[0]
 
     def undamped_modes(self) -> tuple[np.ndarray, np.ndarray]:
-        """Natural frequencies (Hz) and mass-normalised shapes (columns): phi^T M phi = I, phi^T K phi = w^2."""
+        """Natural frequencies and mass-normalised shapes: phi^T M phi = I, phi^T K phi = w^2.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (fn in Hz, shapes as columns).
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid model.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> fn, phi = vm.models.MDOF(np.eye(2), np.array([[2e4, -1e4], [-1e4, 1e4]])).undamped_modes()
+        >>> np.round(phi.T @ phi, 6).tolist()
+        [[1.0, 0.0], [0.0, 1.0]]
+        """
         return self._w / (2 * np.pi), self._phi.copy()
 
     def is_proportional(self) -> bool:
-        """C diagonalised by the undamped modes (classical damping)."""
+        """Whether C is diagonalised by the undamped modes (classical damping).
+
+        Returns
+        -------
+        bool
+
+        Raises
+        ------
+        ParameterError
+            Never.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.models.MDOF(np.eye(2), np.array([[2e4, -1e4], [-1e4, 1e4]]), rayleigh=(0.1, 1e-4)).is_proportional()
+        True
+        """
         Cm = self._phi.T @ self.C @ self._phi
         off = Cm - np.diag(np.diag(Cm))
         return bool(np.abs(off).max() <= 1e-9 * max(np.abs(Cm).max(), 1e-300))
 
     def complex_modes(self):
-        """Eigenvalues lambda (one per oscillating pair, Im > 0) and complex shapes of the state-space
-        problem [0 I; -M^-1 K  -M^-1 C]."""
+        """Eigenvalues and complex shapes of the state-space problem [0 I; -M^-1 K  -M^-1 C].
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (lambda: one per oscillating pair, Im > 0; shapes as columns).
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid model.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> lam, phi = vm.models.MDOF(np.eye(1), np.array([[1e4]]), modal_zeta=[0.02]).complex_modes()
+        >>> round(float(-lam[0].real / abs(lam[0])), 3)
+        0.02
+        """
         n = self.n_dof
         Minv = np.linalg.inv(self.M)
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ self.K, -Minv @ self.C]])
@@ -106,7 +187,24 @@ class MDOF:
         return lam[order], V[:, order]
 
     def modes(self) -> ModalEstimate:
-        """fn (Hz, |lambda| / 2 pi), zeta (-Re lambda / |lambda|) and shapes, as a ModalEstimate."""
+        """The prediction as a ModalEstimate: fn (Hz, |lambda| / 2 pi), zeta (-Re lambda / |lambda|), shapes.
+
+        Returns
+        -------
+        ModalEstimate
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid model.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.models.MDOF(np.eye(2), np.array([[2e4, -1e4], [-1e4, 1e4]])).modes().n_modes
+        2
+        """
         if self.kind == "undamped" or not np.any(self.C):
             fn, phi = self.undamped_modes()
             return ModalEstimate(fn=fn, zeta=np.zeros_like(fn), fn_std=np.zeros_like(fn),
@@ -122,7 +220,32 @@ class MDOF:
                              zeta_std=np.zeros(lam.size), shapes=shapes, method="model:mdof")
 
     def frf(self, freq, *, form: str = "receptance") -> np.ndarray:
-        """H(f) (n_dof, n_dof, n_freq) by direct inversion of K - w^2 M + i w C."""
+        """H(f) by direct inversion of K - w^2 M + i w C.
+
+        Parameters
+        ----------
+        freq : array_like
+            Frequencies in Hz.
+        form : {"receptance", "mobility", "accelerance"}
+            The FRF form.
+
+        Returns
+        -------
+        numpy.ndarray
+            (n_dof, n_dof, n_freq) complex.
+
+        Raises
+        ------
+        ParameterError
+            For an unknown form.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.models.MDOF(np.eye(2), np.array([[2e4, -1e4], [-1e4, 1e4]])).frf([1.0, 2.0]).shape
+        (2, 2, 2)
+        """
         k = {"receptance": 0, "mobility": 1, "accelerance": 2}.get(form)
         if k is None:
             raise ParameterError(f"form={form!r} must be receptance, mobility or accelerance")
@@ -132,8 +255,37 @@ class MDOF:
         return np.transpose(H, (1, 2, 0))
 
     def response(self, t, force, *, x0=None, v0=None) -> np.ndarray:
-        """Displacements (n_dof, n_t) under forces (n_dof, n_t), by modal superposition for
-        proportional damping (each mode exact for a force linear between samples), else state space."""
+        """Displacements under forces, by modal superposition for proportional damping (each mode exact for
+        a force linear between samples), else by state space.
+
+        Parameters
+        ----------
+        t : array_like
+            Uniform times in s.
+        force : array_like
+            Forces (n_dof, n_t) in N.
+        x0, v0 : array_like, optional
+            Initial displacements and velocities.
+
+        Returns
+        -------
+        numpy.ndarray
+            (n_dof, n_t).
+
+        Raises
+        ------
+        ParameterError
+            For a force of the wrong shape or times that are not uniform.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> sys2 = vm.models.MDOF(np.eye(2), np.array([[2e4, -1e4], [-1e4, 1e4]]), modal_zeta=[0.02, 0.02])
+        >>> t = np.arange(1000) / 1000.0
+        >>> sys2.response(t, np.vstack([np.ones(1000), np.zeros(1000)])).shape
+        (2, 1000)
+        """
         from scipy.signal import lsim
         t = np.asarray(t, float)
         F = np.asarray(force, float)
@@ -161,7 +313,32 @@ class MDOF:
         return y.T
 
     def scaled(self, *, k_scale: float = 1.0, c_scale: float = 1.0) -> "MDOF":
-        """The same system with K (and C) multiplied by scale factors (model updating)."""
+        """The same system with K (and C) multiplied by scale factors (model updating).
+
+        Parameters
+        ----------
+        k_scale : float
+            Factor on K.
+        c_scale : float
+            Factor on C.
+
+        Returns
+        -------
+        MDOF
+
+        Raises
+        ------
+        ParameterError
+            For a factor that is not positive.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.MDOF(np.eye(1), np.array([[1e4]])).scaled(k_scale=4.0)
+        >>> round(float(s.modes().fn[0] * 2 * np.pi), 1)
+        200.0
+        """
         return MDOF(self.M, self.K * k_scale, self.C * c_scale if np.any(self.C) else None)
 
     def __repr__(self) -> str:
@@ -169,7 +346,35 @@ class MDOF:
 
 
 def absorber(m1: float, k1: float, m2: float, k2: float, c2: float = 0.0, c1: float = 0.0) -> MDOF:
-    """Main mass m1 on k1 (c1) with an absorber m2 on k2 (c2) attached to it."""
+    """A main mass on a spring with a tuned absorber attached to it (a 2-DOF MDOF).
+
+    Parameters
+    ----------
+    m1, k1 : float
+        Main mass (kg) and stiffness (N/m).
+    m2, k2 : float
+        Absorber mass and stiffness.
+    c2 : float
+        Absorber damping (N s/m).
+    c1 : float
+        Main damping (N s/m).
+
+    Returns
+    -------
+    MDOF
+
+    Raises
+    ------
+    ParameterError
+        For values that are not positive.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> vm.models.absorber(100.0, 1e5, 5.0, 5e3).modes().n_modes
+    2
+    """
     M = np.diag([m1, m2])
     K = np.array([[k1 + k2, -k2], [-k2, k2]])
     C = np.array([[c1 + c2, -c2], [-c2, c2]])
@@ -177,8 +382,30 @@ def absorber(m1: float, k1: float, m2: float, k2: float, c2: float = 0.0, c1: fl
 
 
 def den_hartog(mass_ratio: float) -> dict:
-    """Optimal tuning of a damped absorber (Den Hartog): frequency ratio 1/(1 + mu) and damping
-    ratio sqrt(3 mu / (8 (1 + mu)^3)) for mass ratio mu = m2/m1."""
+    """Optimal tuning of a damped absorber (Den Hartog).
+
+    Parameters
+    ----------
+    mass_ratio : float
+        mu = m2 / m1.
+
+    Returns
+    -------
+    dict
+        frequency_ratio 1 / (1 + mu) and zeta sqrt(3 mu / (8 (1 + mu)^3)).
+
+    Raises
+    ------
+    ParameterError
+        For a ratio that is not positive.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> round(vm.models.den_hartog(0.05)["frequency_ratio"], 4)
+    0.9524
+    """
     mu = float(mass_ratio)
     if not mu > 0:
         raise ParameterError(f"mass_ratio={mass_ratio} must be > 0")

@@ -81,9 +81,36 @@ def coulomb_response(t, *, fn: float, friction_decay: float, amplitude: float, o
 
 
 class SDOF:
-    """A mass-spring-damper: m (kg), k (N/m) and one of c (N s/m), zeta, or loss_factor (eta).
+    """A mass-spring-damper m x'' + c x' + k x = f.
 
-    Properties: wn (rad/s), fn, fd (Hz), c_crit, zeta, c, Td, log_decrement, Q.
+    Properties: wn (rad/s), fn, fd (Hz), c_crit, zeta, c, Td, log_decrement, Q, regime. A loss factor
+    (hysteretic damping) enters the FRF as k (1 + i eta).
+
+    Parameters
+    ----------
+    m : float
+        Mass in kg.
+    k : float
+        Stiffness in N/m.
+    c : float, optional
+        Viscous damping in N s/m (give one of c, zeta, loss_factor).
+    zeta : float, optional
+        Damping ratio.
+    loss_factor : float, optional
+        Hysteretic loss factor eta.
+
+    Raises
+    ------
+    ParameterError
+        For values that are not positive, or more than one damping given.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+    >>> round(s.fn, 3), round(s.Q, 3)
+    (10.0, 10.0)
     """
 
     def __init__(self, *, m: float = 1.0, k: float, c: float | None = None, zeta: float | None = None,
@@ -145,14 +172,59 @@ class SDOF:
             "critically damped" if np.isclose(self.zeta, 1.0, rtol=1e-9) else "overdamped"
 
     def modes(self) -> ModalEstimate:
-        """The prediction as a ModalEstimate (so vm.compare works the same for every model)."""
+        """The prediction as a ModalEstimate (so ``vm.compare`` works the same for every model).
+
+        Returns
+        -------
+        ModalEstimate
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid model.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> round(float(s.modes().fn[0]), 3)
+        10.0
+        """
         z = self.zeta if self.loss_factor == 0 else self.loss_factor / 2
         return ModalEstimate(fn=[self.fn], zeta=[z], fn_std=[0.0], zeta_std=[0.0], method="model:sdof",
                              extras={"m": self.m, "k": self.k, "c": self.c, "loss_factor": self.loss_factor})
 
     # --- free response -------------------------------------------------------------------------
     def free_response(self, t, *, x0: float = 0.0, v0: float = 0.0) -> np.ndarray:
-        """Displacement from x0, v0 for the under-, critically and over-damped cases (closed forms)."""
+        """Displacement from x0, v0: the under-, critically and over-damped closed forms.
+
+        Parameters
+        ----------
+        t : array_like
+            Times in s.
+        x0 : float
+            Initial displacement.
+        v0 : float
+            Initial velocity.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For times that are not finite.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> float(s.free_response(np.array([0.0]), x0=1.0)[0])
+        1.0
+        """
         t = np.asarray(t, float)
         wn, z = self.wn, self.zeta
         if z < 1 and not np.isclose(z, 1.0, rtol=1e-9):
@@ -167,7 +239,31 @@ class SDOF:
         return c1 * np.exp(s1 * t) + c2 * np.exp(s2 * t)
 
     def time_to_decay(self, ratio: float) -> float:
-        """Time for the envelope exp(-zeta wn t) to fall to ``ratio`` of its start (e.g. 1/50)."""
+        """Time for the envelope exp(-zeta wn t) to fall to ``ratio`` of its start.
+
+        Parameters
+        ----------
+        ratio : float
+            Between 0 and 1 (e.g. 1/50).
+
+        Returns
+        -------
+        float
+            s.
+
+        Raises
+        ------
+        ParameterError
+            For a ratio outside (0, 1), or an undamped system.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> round(s.time_to_decay(1 / 50), 3)
+        1.245
+        """
         if not 0 < ratio < 1:
             raise ParameterError(f"ratio={ratio} must be between 0 and 1")
         if self.zeta == 0:
@@ -175,18 +271,95 @@ class SDOF:
         return float(-np.log(ratio) / (self.zeta * self.wn))
 
     def settling_time(self, fraction: float = 0.02) -> float:
-        """Time until the free or step response stays within ``fraction`` (envelope criterion)."""
+        """Time until the free or step response stays within ``fraction`` (envelope criterion).
+
+        Parameters
+        ----------
+        fraction : float
+            The band, as a share of the start (0.02: 2 %).
+
+        Returns
+        -------
+        float
+            s.
+
+        Raises
+        ------
+        ParameterError
+            For a fraction outside (0, 1).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> round(s.settling_time(0.02), 3)
+        1.245
+        """
         return self.time_to_decay(fraction)
 
     def coulomb_free_response(self, t, *, x0: float, friction_force: float) -> np.ndarray:
-        """Dry friction F instead of viscous damping, released from rest at x0: the amplitude falls
-        by 4 F / k per cycle at wn and stops once it is below F / k."""
+        """Dry friction instead of viscous damping, released from rest at x0: the amplitude falls by 4 F / k
+        per cycle at wn and stops once it is below F / k.
+
+        Parameters
+        ----------
+        t : array_like
+            Times in s.
+        x0 : float
+            Release displacement in m.
+        friction_force : float
+            The friction force F in N.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For a friction force that is not positive.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> float(s.coulomb_free_response(np.array([0.0]), x0=1.0, friction_force=10.0)[0])
+        1.0
+        """
         f = positive(friction_force, "friction_force")
         return coulomb_response(t, fn=self.fn, friction_decay=4 * f / self.k, amplitude=x0)
 
     # --- harmonic response -----------------------------------------------------------------------
     def frf(self, freq, *, form: str = "receptance") -> np.ndarray:
-        """H(f) = 1 / (k - m w^2 + i w c) (receptance; hysteretic: k (1 + i eta)), times (i w)^n."""
+        """H(f) = 1 / (k - m w^2 + i w c) (receptance; hysteretic k (1 + i eta)), times (i w)^n.
+
+        Parameters
+        ----------
+        freq : array_like
+            Frequencies in Hz.
+        form : {"receptance", "mobility", "accelerance"}
+            The FRF form.
+
+        Returns
+        -------
+        numpy.ndarray
+            Complex.
+
+        Raises
+        ------
+        ParameterError
+            For an unknown form.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> round(float(abs(s.frf([0.0])[0]) * 3947.84), 6)   # static compliance 1/k
+        1.0
+        """
         if form not in _FORMS:
             raise ParameterError(f"form={form!r} must be one of {tuple(_FORMS)}")
         w = 2 * np.pi * np.asarray(freq, float)
@@ -194,53 +367,279 @@ class SDOF:
         return h * (1j * w) ** _FORMS[form]
 
     def magnification(self, freq) -> tuple[np.ndarray, np.ndarray]:
-        """Dynamic magnification |X k / F0| and phase lag (rad) of the steady response to a force."""
+        """Dynamic magnification |X k / F0| and phase lag of the steady response to a force.
+
+        Parameters
+        ----------
+        freq : array_like
+            Frequencies in Hz.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (magnification, phase lag in rad).
+
+        Raises
+        ------
+        ParameterError
+            For frequencies that are not finite.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> mag, lag = s.magnification([10.0])
+        >>> round(float(mag[0]), 2), round(float(lag[0]), 3)      # Q at resonance, 90 degrees
+        (10.0, 1.571)
+        """
         h = self.frf(freq) * self.k
         return np.abs(h), -np.angle(h)
 
     def harmonic_response(self, freq, F0: float) -> tuple[np.ndarray, np.ndarray]:
-        """Steady displacement amplitude and phase lag under F0 sin(w t)."""
+        """Steady displacement amplitude and phase lag under F0 sin(w t).
+
+        Parameters
+        ----------
+        freq : array_like
+            Frequencies in Hz.
+        F0 : float
+            Force amplitude in N.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (amplitude in m, phase lag in rad).
+
+        Raises
+        ------
+        ParameterError
+            For frequencies that are not finite.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> x, _ = s.harmonic_response([10.0], 1.0)
+        >>> round(float(x[0]), 5)
+        0.00253
+        """
         mag, ph = self.magnification(freq)
         return mag * F0 / self.k, ph
 
     def transmissibility(self, freq) -> np.ndarray:
         """Force (to the foundation) and displacement (from a moving base) transmissibility:
-        sqrt(1 + (2 zeta r)^2) / sqrt((1 - r^2)^2 + (2 zeta r)^2) - the same for viscous damping."""
+        sqrt(1 + (2 zeta r)^2) / sqrt((1 - r^2)^2 + (2 zeta r)^2) for viscous damping.
+
+        Parameters
+        ----------
+        freq : array_like
+            Frequencies in Hz.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For frequencies that are not finite.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> round(float(s.transmissibility([10.0 * 2 ** 0.5])[0]), 2)   # isolation starts at sqrt(2) fn
+        1.0
+        """
         w = 2 * np.pi * np.asarray(freq, float)
         num = self.k * (1 + 1j * self.loss_factor) + 1j * w * self.c
         return np.abs(num / (self.k * (1 + 1j * self.loss_factor) - self.m * w ** 2 + 1j * w * self.c))
 
     def base_excitation(self, freq, Y: float) -> dict:
-        """Base moving as Y sin(w t): absolute amplitude X = Y T and relative amplitude Z."""
+        """Base moving as Y sin(w t): absolute amplitude X = Y T and relative amplitude Z.
+
+        Parameters
+        ----------
+        freq : array_like
+            Frequencies in Hz.
+        Y : float
+            Base amplitude in m.
+
+        Returns
+        -------
+        dict
+            "absolute" and "relative" amplitudes in m.
+
+        Raises
+        ------
+        ParameterError
+            For frequencies that are not finite.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> round(float(s.base_excitation([10.0], 1e-3)["relative"][0] * 1e3), 2)   # Q x Y at resonance
+        10.0
+        """
         w = 2 * np.pi * np.asarray(freq, float)
         T = self.transmissibility(freq)
         rel = np.abs(self.m * w ** 2 * self.frf(freq)) * Y
         return {"absolute": T * Y, "relative": rel}
 
     def unbalance_response(self, freq, *, me: float) -> np.ndarray:
-        """Amplitude from a rotating unbalance me (kg m) at rotation frequency f: me w^2 |H|."""
+        """Amplitude from a rotating unbalance me (kg m) at rotation frequency f: me w^2 |H|.
+
+        Parameters
+        ----------
+        freq : array_like
+            Rotation frequencies in Hz.
+        me : float
+            Unbalance in kg m.
+
+        Returns
+        -------
+        numpy.ndarray
+            m.
+
+        Raises
+        ------
+        ParameterError
+            For an unbalance that is not positive.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> round(float(s.unbalance_response([10.0], me=0.01)[0]), 3)   # Q me / m at resonance
+        0.1
+        """
         w = 2 * np.pi * np.asarray(freq, float)
         return positive(me, "me") * w ** 2 * np.abs(self.frf(freq))
 
     # --- transient response ------------------------------------------------------------------
     def impulse_response(self, t) -> np.ndarray:
-        """Displacement per unit impulse (N s): the free response from v0 = 1/m."""
+        """Displacement per unit impulse (N s): the free response from v0 = 1/m.
+
+        Parameters
+        ----------
+        t : array_like
+            Times in s.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For times that are not finite.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> float(s.impulse_response(np.array([0.0]))[0])
+        0.0
+        """
         return self.free_response(t, x0=0.0, v0=1.0 / self.m)
 
     def step_response(self, t, F0: float = 1.0) -> np.ndarray:
-        """Displacement under a force F0 switched on at t = 0 (from rest)."""
+        """Displacement under a force F0 switched on at t = 0, from rest.
+
+        Parameters
+        ----------
+        t : array_like
+            Times in s.
+        F0 : float
+            Force in N.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For times that are not finite.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> round(float(s.step_response(np.array([10.0]))[0] * 3947.84), 3)   # settles at F0 / k
+        1.0
+        """
         return F0 / self.k * (1 - self.free_response(t, x0=1.0, v0=0.0))
 
     def ramp_response(self, t, rate: float = 1.0) -> np.ndarray:
-        """Displacement under F = rate t from rest: the integral of the step response."""
+        """Displacement under F = rate t from rest: the integral of the step response.
+
+        Parameters
+        ----------
+        t : array_like
+            Times in s.
+        rate : float
+            Force rate in N/s.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For times that are not finite.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> float(s.ramp_response(np.array([0.0]))[0])
+        0.0
+        """
         t = np.asarray(t, float)
         # x = (rate/k) (t - 2 zeta/wn) + rate/k * free response from x0 = 2 zeta/wn, v0 = -1
         return rate / self.k * (t - 2 * self.zeta / self.wn + self.free_response(t, x0=2 * self.zeta / self.wn,
                                                                                v0=-1.0))
 
     def response(self, t, force) -> np.ndarray:
-        """Displacement under an arbitrary force sampled at times t (from rest), by exact
-        state-space integration with the force linear between samples."""
+        """Displacement under an arbitrary force sampled at times t, from rest, by exact state-space
+        integration with the force linear between samples.
+
+        Parameters
+        ----------
+        t : array_like
+            Uniform times in s.
+        force : array_like
+            Force samples in N.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For times that are not uniform or a force of another length.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> t = np.arange(20000) / 1000.0
+        >>> round(float(s.response(t, np.ones(t.size))[-1] * 3947.84), 3)
+        1.0
+        """
         from scipy.signal import lsim
         t = np.asarray(t, float)
         force = np.asarray(force, float)
@@ -251,8 +650,36 @@ class SDOF:
         return y
 
     def periodic_response(self, t, *, period: float, a0: float = 0.0, a=(), b=()) -> np.ndarray:
-        """Steady response to F(t) = a0/2 + sum a_n cos(n w t) + b_n sin(n w t) (Fourier series),
-        each harmonic through the FRF."""
+        """Steady response to F(t) = a0/2 + sum a_n cos(n w t) + b_n sin(n w t), each harmonic through the FRF.
+
+        Parameters
+        ----------
+        t : array_like
+            Times in s.
+        period : float
+            The force's period in s.
+        a0 : float
+            Twice the mean force.
+        a, b : sequence of float
+            Cosine and sine coefficients of harmonics 1, 2, ...
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For a period that is not positive.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> s = vm.models.SDOF(m=1.0, k=3947.84, zeta=0.05)     # 10 Hz, Q 10
+        >>> s.periodic_response(np.arange(5) / 100.0, period=0.4, b=[1.0, 0.0, 1 / 3]).shape
+        (5,)
+        """
         t = np.asarray(t, float)
         w0 = 2 * np.pi / positive(period, "period")
         x = np.full_like(t, a0 / 2 / self.k)
@@ -269,5 +696,30 @@ class SDOF:
 
 
 def stiffness_for(fn: float, m: float) -> float:
-    """Stiffness k = m (2 pi fn)^2 that puts mass m at natural frequency fn."""
+    """Stiffness k = m (2 pi fn)^2 that puts a mass at a natural frequency.
+
+    Parameters
+    ----------
+    fn : float
+        Natural frequency in Hz.
+    m : float
+        Mass in kg.
+
+    Returns
+    -------
+    float
+        N/m.
+
+    Raises
+    ------
+    ParameterError
+        For values that are not positive.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> round(vm.models.stiffness_for(10.0, 1.0), 1)
+    3947.8
+    """
     return positive(m, "m") * (2 * np.pi * positive(fn, "fn")) ** 2

@@ -12,8 +12,36 @@ __all__ = ["update_sdof", "update_mdof"]
 
 
 def update_sdof(est: ModalEstimate, *, m: float, mode: int = 0) -> dict:
-    """k and c of an SDOF with known mass m from a measured mode: k = m wn^2, c = 2 zeta sqrt(k m),
-    with standard deviations by first-order propagation. Returns {"model", "k", "k_std", "c", "c_std"}."""
+    """k and c of an SDOF with known mass from a measured mode: k = m wn^2, c = 2 zeta sqrt(k m), with
+    stds by first-order propagation.
+
+    Parameters
+    ----------
+    est : ModalEstimate
+        The measured mode(s).
+    m : float
+        The known mass in kg.
+    mode : int
+        Which mode.
+
+    Returns
+    -------
+    dict
+        model, k, k_std, c, c_std.
+
+    Raises
+    ------
+    ParameterError
+        For a mode the estimate does not hold or a mass that is not positive.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> meas = vm.ModalEstimate(fn=[10.0], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001])
+    >>> round(vm.models.update_sdof(meas, m=1.0)["k"], 1)
+    3947.8
+    """
     from .sdof import SDOF
     if not isinstance(est, ModalEstimate):
         raise ParameterError(f"est must be a vm.ModalEstimate, got {type(est).__name__}")
@@ -34,8 +62,35 @@ def update_sdof(est: ModalEstimate, *, m: float, mode: int = 0) -> dict:
 
 
 def update_mdof(model, est: ModalEstimate) -> dict:
-    """One stiffness scale s (K -> s K) fitted to the measured frequencies by weighted least squares
-    on w^2 (weights 1/var), with its standard deviation; modes paired in order of frequency."""
+    """One stiffness scale s (K -> s K) fitted to measured frequencies by weighted least squares on w^2
+    (weights 1/var), with its std; modes paired in order of frequency.
+
+    Parameters
+    ----------
+    model : MDOF
+        The model.
+    est : ModalEstimate
+        The measured modes with their stds.
+
+    Returns
+    -------
+    dict
+        model (the updated MDOF), k_scale, k_scale_std.
+
+    Raises
+    ------
+    ParameterError
+        For an estimate without stds or more modes than the model.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> m = vm.models.MDOF(np.eye(1), np.array([[1e4]]))
+    >>> meas = vm.ModalEstimate(fn=[m.modes().fn[0] * 1.1], zeta=[0.01], fn_std=[0.01], zeta_std=[0.001])
+    >>> round(vm.models.update_mdof(m, meas)["k_scale"], 2)
+    1.21
+    """
     pred = model.modes()
     n = min(pred.n_modes, est.n_modes)
     wp2 = (2 * np.pi * pred.fn[:n]) ** 2
