@@ -17,7 +17,31 @@ __all__ = ["Channel", "Record"]
 
 @dataclass(frozen=True)
 class Channel:
-    """Metadata of one channel: ``name``, physical ``quantity``, ``unit`` and sensor ``location``."""
+    """Metadata of one channel.
+
+    Parameters
+    ----------
+    name : str
+        The channel's name.
+    quantity : str
+        "displacement", "velocity", "acceleration", "force", "time" or "unknown".
+    unit : str
+        Its unit ("g", "m/s^2", "mm/s", "N", ...).
+    location : str
+        Where the sensor sits.
+
+    Raises
+    ------
+    ParameterError
+        For an unknown quantity, or a unit of another quantity.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> vm.Channel("acc1", "acceleration", "g").unit
+    'g'
+    """
 
     name: str
     quantity: str = "unknown"
@@ -45,10 +69,36 @@ def _freeze(a: np.ndarray) -> np.ndarray:
 class Record:
     """A multichannel time series sampled at ``fs`` Hz.
 
-    ``data`` has shape (n_channels, n_samples) with time on the last axis (a 1-D array is one
-    channel). ``fs`` is required and never defaulted. ``history`` holds one line per transform
-    applied since the data were read or made (provenance). Records are immutable; transforms
-    return new records.
+    Records are immutable; transforms return new records, and ``history`` holds one line per transform
+    since the data were read or made (provenance). ``fs`` is required and never defaulted.
+
+    Parameters
+    ----------
+    data : array_like
+        (n_channels, n_samples), time on the last axis (a 1-D array is one channel).
+    fs : float
+        Sampling rate in Hz.
+    channels : sequence of Channel or str
+        One per row (default "ch0", "ch1", ... of unknown quantity).
+    t0 : float
+        Time of the first sample in s.
+    meta : mapping
+        Anything else the source states (rpm, time, source file).
+    history : tuple of str
+        Provenance lines.
+
+    Raises
+    ------
+    ParameterError
+        For NaN, inf or complex data, fs that is not positive, or channels that do not match the rows.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> rec = vm.Record(np.zeros((2, 100)), fs=100.0, channels=[vm.Channel("a", "acceleration", "g"), "b"])
+    >>> rec.names, rec.duration
+    (['a', 'b'], 1.0)
     """
 
     data: np.ndarray
@@ -139,7 +189,29 @@ class Record:
 
     # selection --------------------------------------------------------------------------
     def index(self, channel: str | int) -> int:
-        """Index of a channel given by name or position; unknown names raise ParameterError."""
+        """Index of a channel given by name or position.
+
+        Parameters
+        ----------
+        channel : str or int
+            Name or position.
+
+        Returns
+        -------
+        int
+
+        Raises
+        ------
+        ParameterError
+            For an unknown name or a position out of range.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.Record(np.zeros((2, 3)), fs=1.0, channels=["a", "b"]).index("b")
+        1
+        """
         if isinstance(channel, (int, np.integer)) and not isinstance(channel, bool):
             if not -self.n_channels <= channel < self.n_channels:
                 raise ParameterError(f"channel={channel} is out of range for {self.n_channels} channels")
@@ -150,7 +222,29 @@ class Record:
         return names.index(channel)
 
     def select(self, channels: str | int | Iterable[str | int]) -> "Record":
-        """A record holding only the given channels (names or positions), in that order."""
+        """A record holding only the given channels, in that order.
+
+        Parameters
+        ----------
+        channels : str, int or sequence
+            Names or positions.
+
+        Returns
+        -------
+        Record
+
+        Raises
+        ------
+        ParameterError
+            For an unknown channel.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.Record(np.zeros((3, 4)), fs=1.0, channels=["a", "b", "c"]).select(["c", "a"]).names
+        ['c', 'a']
+        """
         if isinstance(channels, (str, int, np.integer)):
             channels = [channels]
         idx = [self.index(c) for c in channels]
@@ -163,11 +257,55 @@ class Record:
         return self.select(channel)
 
     def channel(self, channel: str | int) -> np.ndarray:
-        """The samples of one channel as a read-only 1-D array."""
+        """The samples of one channel as a read-only 1-D array.
+
+        Parameters
+        ----------
+        channel : str or int
+            Name or position.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For an unknown channel.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.Record(np.arange(6.0).reshape(2, 3), fs=1.0).channel(1).tolist()
+        [3.0, 4.0, 5.0]
+        """
         return self.data[self.index(channel)]
 
     def slice_time(self, start: float | None = None, stop: float | None = None) -> "Record":
-        """The part of the record between ``start`` and ``stop`` seconds (relative to ``t0``)."""
+        """The part of the record between ``start`` and ``stop`` seconds (relative to ``t0``).
+
+        Parameters
+        ----------
+        start, stop : float, optional
+            Seconds (default the record's ends).
+
+        Returns
+        -------
+        Record
+
+        Raises
+        ------
+        ParameterError
+            For an empty or reversed interval.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.Record(np.zeros(100), fs=10.0).slice_time(2.0, 4.0).n_samples
+        20
+        """
         i0 = 0 if start is None else int(round((start - self.t0) * self.fs))
         i1 = self.n_samples if stop is None else int(round((stop - self.t0) * self.fs))
         i0, i1 = max(i0, 0), min(i1, self.n_samples)
@@ -179,13 +317,62 @@ class Record:
 
     # transforms -------------------------------------------------------------------------
     def replace(self, *, note: str | None = None, **changes) -> "Record":
-        """A new record with fields changed; ``note`` appends a line to ``history``."""
+        """A new record with fields changed; ``note`` appends a line to ``history``.
+
+        Parameters
+        ----------
+        note : str, optional
+            The provenance line.
+        **changes
+            Fields to change (data, fs, channels, t0, meta).
+
+        Returns
+        -------
+        Record
+
+        Raises
+        ------
+        ParameterError
+            For changes that make an invalid record.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.Record(np.zeros(10), fs=10.0).replace(fs=20.0, note="fs corrected").history[-1]
+        'fs corrected'
+        """
         hist = self.history + ((note,) if note else ())
         changes.setdefault("history", hist)
         return dataclasses.replace(self, **changes)
 
     def to_unit(self, unit: str, *, channel: str | int | None = None) -> "Record":
-        """Convert one channel (or every channel of the unit's quantity) to ``unit``."""
+        """Convert one channel (or every channel of the unit's quantity) to ``unit``.
+
+        Parameters
+        ----------
+        unit : str
+            The target unit.
+        channel : str or int, optional
+            One channel (default every channel of that quantity).
+
+        Returns
+        -------
+        Record
+
+        Raises
+        ------
+        UnitError
+            For a unit of another quantity, or a channel without a unit.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> rec = vm.Record.from_array(np.ones(3), fs=1.0, unit="g")
+        >>> round(float(rec.to_unit("m/s^2").data[0, 0]), 5)
+        9.80665
+        """
         target_q = _units.quantity_of(unit)
         idx = range(self.n_channels) if channel is None else [self.index(channel)]
         data = np.array(self.data)
@@ -206,7 +393,24 @@ class Record:
         return self.replace(data=data, channels=tuple(chans), note=f"to_unit({unit!r}, {done})")
 
     def to_frame(self):
-        """A pandas DataFrame with a time column (s) and one column per channel."""
+        """A pandas DataFrame with a time column (s) and one column per channel.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid record.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> list(vm.Record(np.zeros((1, 3)), fs=1.0, channels=["a"]).to_frame().columns)
+        ['time', 'a']
+        """
         import pandas as pd
         df = pd.DataFrame(self.data.T, columns=self.names)
         df.insert(0, "time", self.time)

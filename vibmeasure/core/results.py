@@ -58,12 +58,43 @@ def _arr(x, n, name, fill=np.nan):
 
 @dataclass(frozen=True)
 class ModalEstimate:
-    """Natural frequencies and damping ratios of one or more modes, with uncertainty.
+    """Natural frequencies and damping ratios of one or more modes, with their uncertainty.
 
-    ``fn`` is the undamped natural frequency in Hz, ``zeta`` the viscous damping ratio (a ratio,
-    not %), ``fn_std``/``zeta_std`` their standard deviations (NaN only when a method gives none).
-    ``flags`` are quality findings for the whole estimate, ``mode_flags`` per mode. ``extras``
-    holds method-specific detail (noise level, samples used, friction, damping vs amplitude...).
+    Parameters
+    ----------
+    fn : array_like
+        Undamped natural frequencies in Hz.
+    zeta : array_like
+        Viscous damping ratios (a ratio, not %).
+    fn_std, zeta_std : array_like, optional
+        Standard deviations (NaN only where a method gives none).
+    method : str
+        The method that made it.
+    flags : tuple of str
+        Quality findings for the whole estimate (``FLAG_TEXT`` says what each means).
+    mode_flags : tuple of tuple of str, optional
+        Findings per mode.
+    amplitude, phase : array_like, optional
+        Per mode (ring-downs).
+    shapes : array_like, optional
+        Mode shapes (n_outputs, n_modes).
+    unit : str
+        The amplitude's unit.
+    extras : mapping
+        Method-specific detail (noise level, backbone, stabilisation table, rejected modes, ...).
+
+    Raises
+    ------
+    ParameterError
+        For arrays of different lengths.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> est = vm.ModalEstimate(fn=[10.0], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001])
+    >>> est.n_modes, est.mode(0)["fn_hz"]
+    (1, 10.0)
     """
 
     fn: np.ndarray
@@ -125,7 +156,30 @@ class ModalEstimate:
             return 2 * np.pi * self.zeta / np.sqrt(1 - self.zeta ** 2)
 
     def mode(self, i: int) -> dict:
-        """One mode as a dict with the documented JSON keys."""
+        """One mode as a dict with the documented JSON keys.
+
+        Parameters
+        ----------
+        i : int
+            The mode.
+
+        Returns
+        -------
+        dict
+            fn_hz, fn_std_hz, zeta, zeta_std, amplitude, phase, flags, ...
+
+        Raises
+        ------
+        ParameterError
+            For a mode out of range.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.ModalEstimate(fn=[10.0], zeta=[0.02]).mode(0)["zeta"]
+        0.02
+        """
         return {
             "fn_hz": _num(self.fn[i]), "zeta": _num(self.zeta[i]),
             "fn_std_hz": _num(self.fn_std[i]), "zeta_std": _num(self.zeta_std[i]),
@@ -134,13 +188,47 @@ class ModalEstimate:
         }
 
     def to_dict(self) -> dict:
-        """JSON-ready dict: ``modes`` (list of per-mode dicts), ``method``, ``flags``, ``unit``, ``extras``."""
+        """JSON-ready dict: ``modes`` (per-mode dicts), ``method``, ``flags``, ``unit``, ``extras``.
+
+        Returns
+        -------
+        dict
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid estimate.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> sorted(vm.ModalEstimate(fn=[10.0], zeta=[0.02]).to_dict())[:3]
+        ['extras', 'flags', 'method']
+        """
         return {"method": self.method, "flags": list(self.flags), "unit": self.unit,
                 "modes": [self.mode(i) for i in range(self.n_modes)],
                 "extras": jsonable(dict(self.extras))}
 
     def to_frame(self):
-        """A pandas table, one row per mode."""
+        """A pandas table, one row per mode.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid estimate.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.ModalEstimate(fn=[10.0, 20.0], zeta=[0.02, 0.01]).to_frame()["fn_hz"].tolist()
+        [10.0, 20.0]
+        """
         import pandas as pd
         return pd.DataFrame({"fn_hz": self.fn, "fn_std_hz": self.fn_std, "zeta": self.zeta,
                              "zeta_std": self.zeta_std, "amplitude": self.amplitude,
@@ -194,10 +282,36 @@ def jsonable(obj):
 class Spectrum:
     """A frequency-domain result: ``values`` (n_channels, n_freq) at ``freq`` (Hz).
 
-    ``kind`` is "amplitude" (scaling peak, rms or peak-to-peak, in the channel unit), "psd"
-    (density, unit^2/Hz), "power" (unit^2 per line), "envelope" (amplitude of the squared
-    envelope's spectrum), "csd" (complex) or "coherence" (ratio). ``params`` holds what it was made
-    with (window, nperseg, noverlap, nfft, detrend, average, n_averages, enbw_hz, scaling).
+    Parameters
+    ----------
+    freq : array_like
+        Frequencies in Hz.
+    values : array_like
+        (n_channels, n_freq).
+    kind : str
+        "amplitude", "psd" (unit^2/Hz), "power" (unit^2 per line), "envelope", "csd" (complex) or
+        "coherence".
+    unit : str
+        The values' unit.
+    channels : tuple of str
+        Channel names.
+    quantity : str
+        The channels' quantity.
+    params : mapping
+        What it was made with (window, nperseg, noverlap, nfft, detrend, average, n_averages, enbw_hz).
+
+    Raises
+    ------
+    ParameterError
+        For shapes that do not match.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> s = vm.Spectrum(np.arange(4.0), np.ones((1, 4)), "amplitude", unit="g", channels=("a",))
+    >>> s.df
+    1.0
     """
 
     freq: np.ndarray
@@ -237,11 +351,51 @@ class Spectrum:
         return self.values.shape[0]
 
     def channel(self, channel: str | int = 0) -> np.ndarray:
+        """The values of one channel.
+
+        Parameters
+        ----------
+        channel : str or int
+            Name or position.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For an unknown channel.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> vm.Spectrum(np.arange(3.0), np.ones((1, 3)), "amplitude", channels=("a",)).channel("a").tolist()
+        [1.0, 1.0, 1.0]
+        """
         from ._validate import name_index
         return self.values[name_index(self.channels, channel)]
 
     def to_frame(self):
-        """A pandas table: a freq_hz column and one column per channel."""
+        """A pandas table: a freq_hz column and one column per channel.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid object.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> list(vm.Spectrum(np.arange(3.0), np.ones((1, 3)), "amplitude", channels=("a",)).to_frame().columns)
+        ['freq_hz', 'a']
+        """
         import pandas as pd
         df = pd.DataFrame(self.values.T, columns=list(self.channels))
         df.insert(0, "freq_hz", self.freq)
@@ -254,7 +408,36 @@ class Spectrum:
 
 @dataclass(frozen=True)
 class Spectrogram:
-    """Power spectral density over time: ``values`` (n_channels, n_freq, n_times)."""
+    """Power spectral density over time.
+
+    Parameters
+    ----------
+    freq : array_like
+        Frequencies in Hz.
+    times : array_like
+        Segment centres in s.
+    values : array_like
+        (n_channels, n_freq, n_times).
+    unit : str
+        The values' unit.
+    channels : tuple of str
+        Channel names.
+    params : mapping
+        What it was made with.
+
+    Raises
+    ------
+    ParameterError
+        For shapes that do not match.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> sg = vm.spectrogram(vm.Record.from_array(np.random.default_rng(1).normal(size=4096), fs=1000.0), nperseg=256)
+    >>> sg.values.ndim
+    3
+    """
 
     freq: np.ndarray
     times: np.ndarray
@@ -272,10 +455,37 @@ class Spectrogram:
 
 @dataclass(frozen=True)
 class Peaks:
-    """Spectral peaks: interpolated frequency (Hz), scalloping-corrected amplitude, prominence.
+    """Spectral peaks: interpolated frequency, scalloping-corrected amplitude and prominence.
 
-    ``families`` maps a family name ("harmonics of 29.93 Hz", "sidebands of 1200 Hz +- 29.9 Hz")
-    to a list of dicts (order, expected_hz, found_hz, amplitude) when families were searched.
+    Parameters
+    ----------
+    freq : array_like
+        Frequencies in Hz, strongest peak first.
+    amplitude : array_like
+        Amplitudes in the spectrum's unit.
+    prominence : array_like
+        Prominences in the spectrum's unit.
+    channel : str
+        The channel.
+    unit : str
+        The unit.
+    kind : str
+        The spectrum's kind.
+    families : mapping
+        Family name -> list of dicts (order, expected_hz, found_hz, amplitude) when searched.
+
+    Raises
+    ------
+    ParameterError
+        For arrays of different lengths.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> p = vm.Peaks(freq=np.array([50.0]), amplitude=np.array([1.0]), prominence=np.array([0.9]))
+    >>> len(p)
+    1
     """
 
     freq: np.ndarray
@@ -300,7 +510,25 @@ class Peaks:
         return self.freq.size
 
     def to_frame(self):
-        """A pandas table with freq, amplitude, prominence and unit, strongest first."""
+        """A pandas table with freq, amplitude, prominence and unit, strongest first.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid object.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> p = vm.Peaks(freq=np.array([50.0]), amplitude=np.array([1.0]), prominence=np.array([0.9]))
+        >>> p.to_frame()["freq_hz"].tolist()
+        [50.0]
+        """
         import pandas as pd
         return pd.DataFrame({"freq_hz": self.freq, "amplitude": self.amplitude, "prominence": self.prominence,
                              "unit": [self.unit] * self.freq.size})
@@ -325,11 +553,39 @@ def form_of(quantity: str) -> str:
 class FRF:
     """Frequency response functions: complex ``h`` (n_out, n_in, n_freq) at ``freq`` (Hz).
 
-    ``form`` is "receptance" (displacement/force), "mobility" (velocity/force), "accelerance"
-    (acceleration/force) or "unknown". ``coherence`` is (n_out, n_freq): ordinary coherence for one
-    input, multiple coherence for several. ``random_error`` is the normalised random error of |H|
-    per line (from coherence and the number of averages). ``params`` holds how it was made
-    (estimator, window, nperseg, n_averages, exp_window_tau_s for impact tests, flags).
+    Parameters
+    ----------
+    freq : array_like
+        Frequencies in Hz.
+    h : array_like
+        Complex (n_out, n_in, n_freq).
+    form : str
+        "receptance" (displacement/force), "mobility" (velocity/force), "accelerance" or "unknown".
+    coherence : array_like, optional
+        (n_out, n_freq): ordinary coherence for one input, multiple for several.
+    estimator : str
+        "H1", "H2", "Hv" or "" (synthesised).
+    outputs, inputs : tuple of str
+        Channel names.
+    unit : str
+        The FRF's unit.
+    random_error : array_like, optional
+        Normalised random error of |H| per line.
+    params : mapping
+        How it was made (estimator, window, nperseg, n_averages, exp_window_tau_s, flags).
+
+    Raises
+    ------
+    ParameterError
+        For shapes that do not match or an unknown form.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> h = vm.synth.modal_frf(np.linspace(1, 100, 100), fn=[30.0], zeta=[0.02], shapes=[[1.0]])
+    >>> h.n_outputs, h.form
+    (1, 'receptance')
     """
 
     freq: np.ndarray
@@ -386,9 +642,29 @@ class FRF:
         return float(self.freq[1] - self.freq[0]) if self.freq.size > 1 else float("nan")
 
     def to(self, form: str) -> "FRF":
-        """The same FRF as receptance, mobility or accelerance (multiplying by (i w)^k).
+        """The same FRF in another form, multiplying by (i w)^k; converting back returns the data exactly.
 
-        Converting back to the form the data came in returns that data exactly.
+        Parameters
+        ----------
+        form : {"receptance", "mobility", "accelerance"}
+            The target form.
+
+        Returns
+        -------
+        FRF
+
+        Raises
+        ------
+        ParameterError
+            For an unknown form, or an FRF whose form is unknown.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> h = vm.synth.modal_frf(np.linspace(1, 100, 100), fn=[30.0], zeta=[0.02], shapes=[[1.0]])
+        >>> h.to("mobility").form
+        'mobility'
         """
         import dataclasses
         if form not in _FORM_ORDER:
@@ -407,7 +683,30 @@ class FRF:
         return dataclasses.replace(self, h=h, form=form, unit="", params=dict(self.params, _origin=origin))
 
     def select(self, outputs=None, inputs=None) -> "FRF":
-        """A sub-FRF with the named (or indexed) outputs and inputs."""
+        """A sub-FRF with the named (or indexed) outputs and inputs.
+
+        Parameters
+        ----------
+        outputs, inputs : str, int or sequence, optional
+            Default all.
+
+        Returns
+        -------
+        FRF
+
+        Raises
+        ------
+        ParameterError
+            For an unknown or out-of-range output or input.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> h = vm.synth.modal_frf(np.linspace(1, 100, 100), fn=[30.0], zeta=[0.02], shapes=[[1.0], [0.5]])
+        >>> h.select(outputs=[1]).n_outputs
+        1
+        """
         import dataclasses
 
         from ._validate import select_names
@@ -423,7 +722,25 @@ class FRF:
             params={k: v for k, v in self.params.items() if k != "_origin"})
 
     def to_frame(self):
-        """A long pandas table: freq_hz, output, input, re, im, magnitude, phase_deg (and coherence)."""
+        """A long pandas table: freq_hz, output, input, re, im, magnitude, phase_deg (and coherence).
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid object.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> h = vm.synth.modal_frf(np.linspace(1, 100, 100), fn=[30.0], zeta=[0.02], shapes=[[1.0]])
+        >>> len(h.to_frame())
+        100
+        """
         import pandas as pd
         rows = []
         for o in range(self.n_outputs):
@@ -443,9 +760,42 @@ class FRF:
 
 @dataclass(frozen=True)
 class Kurtogram:
-    """Per level of the 1/3-binary tree: ``levels`` (0, 1, 1.6, 2, ...), ``n_bands``, and per band
-    ``kurtosis`` and ``negentropy`` (lists of arrays, one per level; negentropy is the mean of the
-    time- and frequency-domain excess). ``band`` is the chosen (lo, hi) in Hz by ``criterion``."""
+    """A fast kurtogram and infogram: per level of the 1/3-binary tree, per band, kurtosis and negentropy.
+
+    Parameters
+    ----------
+    fs : float
+        Sampling rate in Hz.
+    levels : tuple
+        Levels of the tree (0, 1, 1.6, 2, ...).
+    n_bands : tuple
+        Bands per level.
+    kurtosis, negentropy : tuple of numpy.ndarray
+        One array per level (negentropy: the mean of the time- and frequency-domain excess).
+    band : tuple of float
+        The chosen (lo, hi) in Hz.
+    criterion : str
+        What chose it: "kurtosis" or "negentropy".
+    value : float
+        Its value there.
+    min_bandwidth : float
+        The narrowest band in Hz.
+    params : dict
+        How it was made.
+
+    Raises
+    ------
+    ParameterError
+        Never for a ``vm.kurtogram`` result.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> kg = vm.kurtogram(vm.synth.machine(fault="bearing_outer_race", rpm=1797, duration=1.0, seed=1))
+    >>> len(kg.levels) == len(kg.kurtosis)
+    True
+    """
 
     fs: float
     levels: tuple
@@ -459,7 +809,31 @@ class Kurtogram:
     params: dict = field(default_factory=dict)
 
     def best(self, criterion: str = "kurtosis") -> tuple:
-        """(lo, hi, level, value) of the band with the largest kurtosis or negentropy."""
+        """The band with the largest kurtosis or negentropy.
+
+        Parameters
+        ----------
+        criterion : {"kurtosis", "negentropy"}
+            Which map.
+
+        Returns
+        -------
+        tuple
+            (lo, hi, level, value).
+
+        Raises
+        ------
+        ParameterError
+            For an unknown criterion.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> kg = vm.kurtogram(vm.synth.machine(fault="bearing_outer_race", rpm=1797, duration=1.0, seed=1))
+        >>> len(kg.best())
+        4
+        """
         rows = self.kurtosis if criterion == "kurtosis" else self.negentropy
         best = (np.nan, np.nan, np.nan, -np.inf)
         for lev, nb, vals in zip(self.levels, self.n_bands, rows):
@@ -470,7 +844,33 @@ class Kurtogram:
         return best
 
     def image(self, criterion: str = "kurtosis", n_cols: int = 768) -> np.ndarray:
-        """The map as an image (levels x frequency columns) for plotting."""
+        """The map as an image (levels x frequency columns) for plotting.
+
+        Parameters
+        ----------
+        criterion : {"kurtosis", "negentropy"}
+            Which map.
+        n_cols : int
+            Frequency columns.
+
+        Returns
+        -------
+        numpy.ndarray
+            (n_levels, n_cols).
+
+        Raises
+        ------
+        ParameterError
+            For an unknown criterion.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> kg = vm.kurtogram(vm.synth.machine(fault="bearing_outer_race", rpm=1797, duration=1.0, seed=1))
+        >>> kg.image(n_cols=100).shape[1]
+        100
+        """
         rows = self.kurtosis if criterion == "kurtosis" else self.negentropy
         out = np.full((len(rows), n_cols), np.nan)
         for r, (nb, vals) in enumerate(zip(self.n_bands, rows)):
@@ -510,6 +910,11 @@ class Diagnosis:
     bearing_checked : bool
         False without a bearing, or where the declared speed is contradicted.
 
+    Raises
+    ------
+    ParameterError
+        Never for a ``vm.diagnose`` result.
+
     Examples
     --------
     >>> import vibmeasure as vm
@@ -537,8 +942,21 @@ class Diagnosis:
         Returns
         -------
         dict
-            top, confidence, score, reason, channel, bearing_checked, faults (records), speed,
-            severity, envelope_band_hz, flags, also, measured_top_hz.
+            top, confidence, score, reason, channel, bearing_checked, faults (records), speed, severity,
+            envelope_band_hz, flags, also, measured_top_hz.
+
+        Raises
+        ------
+        ParameterError
+            Never for a valid object.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> d = vm.diagnose(vm.synth.machine(fault="unbalance", rpm=1797, duration=2.0, seed=1), rpm=1797)
+        >>> d.to_dict()["top"]
+        'unbalance'
         """
         return jsonable({"top": self.top, "confidence": self.confidence, "score": self.extras.get("score"),
                          "reason": self.reason,

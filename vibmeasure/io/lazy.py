@@ -20,11 +20,40 @@ __all__ = ["LazyRecord", "open_record"]
 
 
 class LazyRecord:
-    """A record whose samples stay on disk until a block of them is asked for.
+    """A record whose samples stay on disk until a block of them is asked for (``vm.open``).
 
-    It has what a :class:`~vibmeasure.Record` has except ``data``: ``fs``, ``channels``, ``t0``,
-    ``n_channels``, ``n_samples``, ``duration``, ``names``; ``read(start, stop)`` returns the
-    samples of that range as float64 (n_channels, stop - start); ``load()`` reads it all.
+    It has what a :class:`~vibmeasure.Record` has except ``data``: fs, channels, t0, n_channels,
+    n_samples, duration, names.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The HDF5 file.
+    dataset : str
+        The dataset holding the samples.
+    fs : float
+        Sampling rate in Hz.
+    channels : tuple of Channel
+        One per row.
+    t0 : float
+        Time of the first sample in s.
+    meta : dict, optional
+        What the file states besides.
+
+    Raises
+    ------
+    ParameterError
+        For a dataset that does not match the channels.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import vibmeasure as vm
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "run.h5"
+    >>> _ = vm.write(path, vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=2.0))
+    >>> lazy = vm.open(path)
+    >>> lazy.n_samples, lazy.fs
+    (1000, 500.0)
     """
 
     def __init__(self, path, dataset: str, fs: float, channels: tuple[Channel, ...], t0: float = 0.0,
@@ -65,6 +94,32 @@ class LazyRecord:
         return [c.name for c in self.channels]
 
     def index(self, channel) -> int:
+        """Index of a channel given by name or position.
+
+        Parameters
+        ----------
+        channel : str or int
+            Name or position.
+
+        Returns
+        -------
+        int
+
+        Raises
+        ------
+        ParameterError
+            For an unknown channel.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "run.h5"
+        >>> _ = vm.write(path, vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=2.0))
+        >>> lazy = vm.open(path)
+        >>> lazy.index(0)
+        0
+        """
         if isinstance(channel, (int, np.integer)) and not isinstance(channel, bool):
             if not -self.n_channels <= channel < self.n_channels:
                 raise ParameterError(f"channel={channel} is out of range for {self.n_channels} channels")
@@ -74,9 +129,35 @@ class LazyRecord:
         return self.names.index(channel)
 
     def read(self, start: int, stop: int, out: np.ndarray | None = None) -> np.ndarray:
-        """Samples start..stop of every channel as float64, shape (n_channels, stop - start). ``out``,
-        a C-contiguous float64 array of exactly that shape, is filled instead of a new array (HDF5
-        converts the stored type on the way: no second copy, no fresh pages to fault in)."""
+        """Samples start..stop of every channel as float64, shape (n_channels, stop - start).
+
+        Parameters
+        ----------
+        start, stop : int
+            Sample range.
+        out : numpy.ndarray, optional
+            A C-contiguous float64 array of exactly that shape, filled instead of a new one (no second
+            copy, no fresh pages to fault in).
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        ParameterError
+            For a range outside the record or an ``out`` of the wrong shape.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "run.h5"
+        >>> _ = vm.write(path, vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=2.0))
+        >>> lazy = vm.open(path)
+        >>> lazy.read(0, 10).shape
+        (1, 10)
+        """
         start, stop = max(0, int(start)), min(self.n_samples, int(stop))
         shape = (self.n_channels, stop - start)
         if out is not None and (out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous):
@@ -96,7 +177,27 @@ class LazyRecord:
         return a[np.newaxis] if self._one_d else a
 
     def load(self) -> Record:
-        """Read everything into an in-memory :class:`Record`."""
+        """Read everything into an in-memory Record.
+
+        Returns
+        -------
+        Record
+
+        Raises
+        ------
+        ParameterError
+            For a file changed or damaged since it was opened.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "run.h5"
+        >>> _ = vm.write(path, vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=2.0))
+        >>> lazy = vm.open(path)
+        >>> lazy.load().data.shape
+        (1, 1000)
+        """
         return Record(self.read(0, self.n_samples), self.fs, self.channels, t0=self.t0, meta=self.meta,
                       history=(f"read {self.path} [{self.dataset}]",))
 

@@ -59,16 +59,43 @@ def _check_name(value, what: str) -> str:
 
 
 class Store:
-    """A condition-monitoring store: ``Store(path)`` reads; ``Store(path, writable=True)`` also
-    writes (creating the file) under the writer lock. Use as a context manager: the pending rows are
-    committed on a clean exit and the lock is released.
+    """A condition-monitoring store: assets, points, measurements and results in one HDF5 file.
 
-    >>> with vm.Store("plant.h5", writable=True) as st:
-    ...     st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
-    ...     st.add_point("pump-1", "DE-H", channel="acc", direction="horizontal", unit="g")
-    ...     mid = st.add_measurement("pump-1", "DE-H", time="2026-11-22T08:00", rpm=1480)
-    ...     st.add_result(mid, "diagnose", diag.to_dict(), summary={"top": diag.top})
-    >>> vm.Store("plant.h5").results("diagnose", asset="pump-1")          # a DataFrame
+    ``Store(path)`` reads; ``Store(path, writable=True)`` also writes (creating the file) under the
+    writer lock. As a context manager the pending rows are committed on a clean exit and the lock is
+    released. Commits are copy-on-write and sealed: a writer killed at any moment leaves every earlier
+    commit readable (schema in docs/store.md).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The store file (.h5).
+    writable : bool
+        Open for writing (one writer at a time).
+    timeout : float
+        Seconds to wait for another writer's lock.
+
+    Raises
+    ------
+    ParameterError
+        For a damaged or foreign file, or a missing file opened read-only.
+    StoreLockedError
+        When another process holds the writer lock past ``timeout``.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> import vibmeasure as vm
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+    >>> with vm.Store(path, writable=True) as st:
+    ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+    ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+    ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+    ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+    ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+    >>> st = vm.Store(path)
+    >>> st.results("diagnose")["top"].tolist()
+    ['none']
     """
 
     def __init__(self, path, *, writable: bool = False, timeout: float = 0.0):
@@ -135,7 +162,36 @@ class Store:
                 self._lock_fd = None
 
     def close(self, *, commit: bool = True):
-        """Commit the pending rows (unless ``commit=False``) and release the writer lock."""
+        """Commit the pending rows (unless ``commit=False``) and release the writer lock.
+
+        Parameters
+        ----------
+        commit : bool
+            Commit first.
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        ParameterError
+            When the commit fails (the store keeps its last commit).
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.close()
+        """
         try:
             if commit and self.writable:
                 self.commit()
@@ -229,20 +285,142 @@ class Store:
         return df.reset_index(drop=True)
 
     def assets(self):
-        """Assets as a DataFrame (asset, kind, bearing, gear, model, iso_group, foundation, meta)."""
+        """Assets as a DataFrame (asset, kind, bearing, gear, model, iso_group, foundation, meta).
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ParameterError
+            Never for an open store.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.assets()["asset"].tolist()
+        ['pump-1']
+        """
         return self._frame("assets")
 
     def points(self, asset: str | None = None):
-        """Measurement points as a DataFrame (asset, point, channel, direction, unit)."""
+        """Measurement points as a DataFrame (asset, point, channel, direction, unit).
+
+        Parameters
+        ----------
+        asset : str, optional
+            Only this asset's.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ParameterError
+            Never for an open store.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.points("pump-1")["channel"].tolist()
+        ['acc']
+        """
         return self._frame("points", asset=asset)
 
     def measurements(self, asset: str | None = None, point: str | None = None, since=None, until=None):
-        """Measurements as a DataFrame, oldest first; ``time`` as UTC Timestamps."""
+        """Measurements as a DataFrame, oldest first; ``time`` as UTC Timestamps.
+
+        Parameters
+        ----------
+        asset, point : str, optional
+            Only these.
+        since, until : float, str or datetime, optional
+            Only this time range.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ParameterError
+            For a bad time.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.measurements(asset="pump-1")["rpm"].tolist()
+        [1797.0]
+        """
         return self._timed(self._frame("measurements", asset=asset, point=point), since, until)
 
     def results(self, task: str, asset: str | None = None, point: str | None = None, since=None, until=None):
-        """Results of one task as a DataFrame, oldest first: measurement, asset, point, time, task,
-        version, params, the summary values as columns and ``result`` (the full result, a dict)."""
+        """Results of one task as a DataFrame, oldest first.
+
+        Parameters
+        ----------
+        task : str
+            The task.
+        asset, point : str, optional
+            Only these.
+        since, until : float, str or datetime, optional
+            Only this time range.
+
+        Returns
+        -------
+        pandas.DataFrame
+            measurement, asset, point, time, task, version, params, the summary values as columns and
+            ``result`` (the full result, a dict).
+
+        Raises
+        ------
+        ParameterError
+            For a bad time.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.results("diagnose", asset="pump-1")["top"].tolist()
+        ['none']
+        """
         import pandas as pd
         task = TASK_ALIASES.get(task, task)
         meas = {r["id"]: (r["asset"], r["point"], r["time"]) for r in self._each("measurements")}
@@ -265,7 +443,32 @@ class Store:
         return self._timed(df.reset_index(drop=True), since, until)
 
     def errors(self):
-        """Inputs a batch could not analyse: measurement, file and the error message."""
+        """Inputs a batch could not analyse: measurement, file and the error message.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ParameterError
+            Never for an open store.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> len(st.errors())
+        0
+        """
         return self.results("error")
 
     @staticmethod
@@ -282,7 +485,37 @@ class Store:
         return df
 
     def has(self, sha256: str) -> str | None:
-        """The measurement id already stored for this content hash, or None (the latest if several)."""
+        """The measurement id already stored for a content hash, or None (the latest if several).
+
+        Parameters
+        ----------
+        sha256 : str
+            The content hash.
+
+        Returns
+        -------
+        str or None
+
+        Raises
+        ------
+        ParameterError
+            Never for an open store.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.has("0" * 64) is None
+        True
+        """
         if not isinstance(sha256, str) or not sha256:
             return None   # no hash matches nothing (not a pending measurement stored without a hash)
         for mid in reversed(self._pending_meas):
@@ -315,7 +548,37 @@ class Store:
         return self._n["measurements"] + len(self._pending["measurements"])
 
     def record(self, measurement: str):
-        """The raw record stored with a measurement (``keep_raw=True``)."""
+        """The raw record stored with a measurement (``keep_raw=True``).
+
+        Parameters
+        ----------
+        measurement : str
+            The measurement's id.
+
+        Returns
+        -------
+        Record
+
+        Raises
+        ------
+        ParameterError
+            For an unknown measurement or one stored without its record.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.record("m0000001").fs
+        12000.0
+        """
         from ..core.record import Channel, Record
         if measurement in self._raw_pending:
             return self._raw_pending[measurement]
@@ -335,9 +598,54 @@ class Store:
 
     def add_asset(self, asset: str, *, kind: str = "machine", bearing=None, gear=None, model=None,
                   iso_group: int | None = None, foundation: str | None = None, meta: dict | None = None) -> str:
-        """An asset (a machine or a structure) with what its analysis needs: a bearing (catalogue name
-        or ``N,d,D,angle``), gear teeth, a model (TOML path), the ISO 10816-3 group and foundation.
-        Adding an asset that exists with the same description does nothing; a different one is an error."""
+        """An asset (a machine or a structure) with what its analysis needs.
+
+        Adding an asset that exists with the same description does nothing; a different one is an error.
+
+        Parameters
+        ----------
+        asset : str
+            The asset's name.
+        kind : {"machine", "structure"}
+            What it is.
+        bearing : str or Bearing, optional
+            A catalogue name or "N,d,D,angle".
+        gear : int, optional
+            Gear teeth.
+        model : str, optional
+            A TOML model's path.
+        iso_group : {1, 2}, optional
+            ISO 10816-3 group.
+        foundation : {"rigid", "flexible"}, optional
+            ISO 10816-3 support class.
+        meta : dict, optional
+            Anything else.
+
+        Returns
+        -------
+        str
+            The asset's name.
+
+        Raises
+        ------
+        ParameterError
+            For a bad name, a store opened read-only, or an asset described differently before.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.assets()["bearing"].tolist()
+        ['6205-2RS']
+        """
         self._need_writable()
         _check_name(asset, "asset")
         if iso_group is not None and iso_group not in (1, 2):
@@ -357,7 +665,46 @@ class Store:
 
     def add_point(self, asset: str, point: str, *, channel: str | None = None, direction: str | None = None,
                   unit: str | None = None) -> str:
-        """A measurement point of an asset: the channel it is recorded on, direction, sensor unit."""
+        """A measurement point of an asset.
+
+        Parameters
+        ----------
+        asset : str
+            The asset (added before).
+        point : str
+            The point's name.
+        channel : str, optional
+            The channel it is recorded on.
+        direction : str, optional
+            Measuring direction.
+        unit : str, optional
+            Sensor unit.
+
+        Returns
+        -------
+        str
+            The point's name.
+
+        Raises
+        ------
+        ParameterError
+            For an unknown asset or a store opened read-only.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.points()["point"].tolist()
+        ['DE']
+        """
         self._need_writable()
         _check_name(point, "point")
         if asset not in self._assets:
@@ -375,9 +722,52 @@ class Store:
     def add_measurement(self, asset: str, point: str, *, time, rpm: float | None = None, record=None,
                         keep_raw: bool = False, sha256: str | None = None, file: str | None = None,
                         meta: dict | None = None) -> str:
-        """A measurement of a point at ``time`` (Unix seconds, ISO 8601 or datetime); returns its id.
-        ``record`` with ``keep_raw=True`` stores the raw samples; ``sha256`` (default: of the record's
-        samples) lets a batch skip inputs it has analysed before."""
+        """A measurement of a point at a time.
+
+        Parameters
+        ----------
+        asset, point : str
+            Where it was measured.
+        time : float, str or datetime
+            Unix seconds, ISO 8601 or a datetime.
+        rpm : float, optional
+            Shaft speed.
+        record : Record, optional
+            The record (its samples' hash identifies the content).
+        keep_raw : bool
+            Store the raw samples too.
+        sha256 : str, optional
+            Content hash (default: of the record's samples); lets a batch skip inputs it has analysed.
+        file : str, optional
+            The source file.
+        meta : dict, optional
+            Anything else.
+
+        Returns
+        -------
+        str
+            The measurement's id.
+
+        Raises
+        ------
+        ParameterError
+            For an unknown asset or point, a bad time, or a store opened read-only.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.measurements()["id"].tolist()
+        ['m0000001']
+        """
         self._need_writable()
         if (asset, point) not in self._points:
             raise ParameterError(f"point {asset}/{point} is not in the store: add_point first")
@@ -398,9 +788,45 @@ class Store:
 
     def add_result(self, measurement: str, task: str, result: dict, *, params: dict | None = None,
                    summary: dict | None = None) -> None:
-        """A result of ``task`` for a measurement: the full result (a JSON-able dict, e.g.
-        ``est.to_dict()``), the parameters that produced it and a flat ``summary`` (numbers and short
-        strings) that becomes columns of :meth:`results`. The vibmeasure version is recorded."""
+        """A result of a task for a measurement; the vibmeasure version is recorded.
+
+        Parameters
+        ----------
+        measurement : str
+            The measurement's id.
+        task : str
+            The task ("diagnose", "ringdown", ...).
+        result : dict
+            The full result, JSON-able (e.g. ``est.to_dict()``).
+        params : dict, optional
+            The parameters that produced it.
+        summary : dict, optional
+            Flat numbers and short strings that become columns of ``results``.
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        ParameterError
+            For an unknown measurement, a result that is not JSON-able, or a store opened read-only.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> st.results("diagnose")["measurement"].tolist()
+        ['m0000001']
+        """
         self._need_writable()
         from .. import __version__
         from ..core.results import jsonable
@@ -417,7 +843,35 @@ class Store:
         return sum(len(v) for v in self._pending.values())
 
     def commit(self) -> None:
-        """Make the pending rows durable: copy, append, seal, fsync, rename (see the module doc)."""
+        """Make the pending rows durable: copy, append, seal, fsync, rename.
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        ParameterError
+            For a store opened read-only, or a write that fails (the last commit stays intact).
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "plant.h5"
+        >>> with vm.Store(path, writable=True) as st:
+        ...     _ = st.add_asset("pump-1", bearing="6205-2RS", iso_group=2)
+        ...     _ = st.add_point("pump-1", "DE", channel="acc", unit="g")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797, record=rec, keep_raw=True)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+        >>> st = vm.Store(path)
+        >>> with vm.Store(path, writable=True) as w:
+        ...     _ = w.add_point("pump-1", "NDE")
+        ...     w.commit()
+        >>> sorted(vm.Store(path).points()["point"])
+        ['DE', 'NDE']
+        """
         self._need_writable()
         if not self.pending and self.path.exists():
             return

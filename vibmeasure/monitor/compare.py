@@ -51,7 +51,34 @@ def _pair(meas: ModalEstimate, pred: ModalEstimate, max_rel: float):
 
 @dataclass(frozen=True)
 class Comparison:
-    """Paired modes with deviations and verdicts; ``verdict`` is the worst ("ok", "watch", "alarm")."""
+    """Paired modes with deviations and verdicts (``vm.compare``).
+
+    Parameters
+    ----------
+    rows : tuple of dict
+        One per paired mode: predicted and measured fn and zeta, deviations, dk/k, verdict.
+    verdict : str
+        The worst: "ok", "watch" or "alarm".
+    reason : str
+        Why, in words.
+    unpaired_measured, unpaired_predicted : tuple of float
+        Frequencies that found no partner.
+    settings : dict
+        The tolerances used.
+
+    Raises
+    ------
+    ParameterError
+        Never for a ``vm.compare`` result.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> est = vm.ModalEstimate(fn=[10.0], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001])
+    >>> cmp = vm.compare(est, vm.ModalEstimate(fn=[10.5], zeta=[0.02]))
+    >>> cmp.verdict
+    'alarm'
+    """
 
     rows: tuple
     verdict: str
@@ -61,10 +88,48 @@ class Comparison:
     settings: dict = field(default_factory=dict)
 
     def to_frame(self):
+        """One row per paired mode.
+
+        Returns
+        -------
+        pandas.DataFrame
+
+        Raises
+        ------
+        ParameterError
+            Never.
+
+        Examples
+        --------
+        >>> import vibmeasure as vm
+        >>> est = vm.ModalEstimate(fn=[10.0], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001])
+        >>> cmp = vm.compare(est, vm.ModalEstimate(fn=[10.5], zeta=[0.02]))
+        >>> len(cmp.to_frame())
+        1
+        """
         import pandas as pd
         return pd.DataFrame(list(self.rows))
 
     def to_dict(self) -> dict:
+        """JSON-ready: verdict, reason, modes, unpaired_measured_hz, unpaired_predicted_hz, settings.
+
+        Returns
+        -------
+        dict
+
+        Raises
+        ------
+        ParameterError
+            Never.
+
+        Examples
+        --------
+        >>> import vibmeasure as vm
+        >>> est = vm.ModalEstimate(fn=[10.0], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001])
+        >>> cmp = vm.compare(est, vm.ModalEstimate(fn=[10.5], zeta=[0.02]))
+        >>> cmp.to_dict()["verdict"]
+        'alarm'
+        """
         from ..core.results import jsonable
         return jsonable({"verdict": self.verdict, "reason": self.reason, "modes": list(self.rows),
                           "unpaired_measured_hz": list(self.unpaired_measured),
@@ -169,7 +234,30 @@ def compare(measured, predicted, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.
 
 
 class History:
-    """Modal estimates of one machine/measurement point over time: baseline, trends, HDF5 storage."""
+    """Modal estimates of one measurement point over time: baseline, trends, HDF5 storage.
+
+    Parameters
+    ----------
+    name : str
+        The point's name.
+    baseline_count : int
+        Entries the baseline averages.
+
+    Raises
+    ------
+    ParameterError
+        For a baseline count below 1.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import vibmeasure as vm
+    >>> h = vm.History("pump-3 DE")
+    >>> for day, f in enumerate([10.0, 9.9, 9.8]):
+    ...     _ = h.add(vm.ModalEstimate(fn=[f], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001]), time=day * 86400.0)
+    >>> len(h.entries)
+    3
+    """
 
     def __init__(self, name: str = "point", *, baseline_count: int = 1):
         self.name = str(name)
@@ -177,8 +265,35 @@ class History:
         self.entries: list[tuple[float, ModalEstimate]] = []
 
     def add(self, est: ModalEstimate, *, time) -> "History":
-        """Append an estimate measured at ``time``: seconds (any epoch, e.g. Unix time), a datetime or a
-        pandas Timestamp (stored as Unix seconds, naive times taken as UTC). Times must increase."""
+        """Append an estimate measured at a time; times must increase.
+
+        Parameters
+        ----------
+        est : ModalEstimate
+            The estimate.
+        time : float, datetime or pandas.Timestamp
+            Seconds (any epoch, e.g. Unix time) or a date (naive times taken as UTC).
+
+        Returns
+        -------
+        History
+            Itself, for chaining.
+
+        Raises
+        ------
+        ParameterError
+            For an object that is no estimate, or a time that does not increase.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> h = vm.History("pump-3 DE")
+        >>> for day, f in enumerate([10.0, 9.9, 9.8]):
+        ...     _ = h.add(vm.ModalEstimate(fn=[f], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001]), time=day * 86400.0)
+        >>> h.entries[-1][0]
+        172800.0
+        """
         if not isinstance(est, ModalEstimate):
             raise ParameterError(f"est must be a vm.ModalEstimate, got {type(est).__name__}")
         time = _seconds(time)
@@ -188,7 +303,27 @@ class History:
         return self
 
     def baseline(self) -> ModalEstimate:
-        """The healthy reference: the mean of the first baseline_count entries (per mode, by order)."""
+        """The healthy reference: the mean of the first ``baseline_count`` entries (per mode, by order).
+
+        Returns
+        -------
+        ModalEstimate
+
+        Raises
+        ------
+        ParameterError
+            For an empty history.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> h = vm.History("pump-3 DE")
+        >>> for day, f in enumerate([10.0, 9.9, 9.8]):
+        ...     _ = h.add(vm.ModalEstimate(fn=[f], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001]), time=day * 86400.0)
+        >>> float(h.baseline().fn[0])
+        10.0
+        """
         if not self.entries:
             raise ParameterError(f"history {self.name!r} is empty: add a baseline measurement first")
         base = [e for _, e in self.entries[: self.baseline_count]]
@@ -201,9 +336,40 @@ class History:
 
     def trend(self, *, mode: int = 0, quantity: str = "fn", threshold: float | None = None,
               horizon: float | None = None) -> dict:
-        """Weighted line through one quantity (fn or zeta of a mode, paired by frequency with the
-        baseline) over time: slope with its std, and when it will cross ``threshold``. An early
-        warning ("watch") is raised when the crossing is predicted within ``horizon``."""
+        """Weighted line through one quantity of a mode over time: slope with its std, and when it crosses
+        a threshold ("watch" when predicted within ``horizon``).
+
+        Parameters
+        ----------
+        mode : int
+            The mode (paired by frequency with the baseline).
+        quantity : {"fn", "zeta"}
+            What to trend.
+        threshold : float, optional
+            The level whose crossing is predicted.
+        horizon : float, optional
+            Seconds ahead a predicted crossing makes a watch.
+
+        Returns
+        -------
+        dict
+            slope_per_time, slope_std, value_now, n_points, crossing_time, verdict.
+
+        Raises
+        ------
+        ParameterError
+            For fewer than 3 entries or an unknown quantity.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> h = vm.History("pump-3 DE")
+        >>> for day, f in enumerate([10.0, 9.9, 9.8]):
+        ...     _ = h.add(vm.ModalEstimate(fn=[f], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001]), time=day * 86400.0)
+        >>> round(h.trend()["slope_per_time"] * 86400, 3)
+        -0.1
+        """
         if quantity not in ("fn", "zeta"):
             raise ParameterError(f"quantity={quantity!r} must be 'fn' or 'zeta'")
         if len(self.entries) < 3:
@@ -235,10 +401,38 @@ class History:
 
     # --- storage ---------------------------------------------------------------------------------
     def save(self, path) -> None:
-        """Write to HDF5 (atomic, sealed with a checksum): one group per entry with fn, zeta and their
-        std. Entries another process saved to the same file meanwhile are kept: under an exclusive
-        lock the file is read again and merged (by time and values), so concurrent load-add-save loses
-        no update."""
+        """Write to HDF5, atomically and sealed with a checksum, merging what another process saved meanwhile.
+
+        Under an exclusive lock the file is read again and merged (by time and values), so concurrent
+        load-add-save cycles lose no entry.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        ParameterError
+            For a folder that does not exist or a damaged file at the path.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import vibmeasure as vm
+        >>> h = vm.History("pump-3 DE")
+        >>> for day, f in enumerate([10.0, 9.9, 9.8]):
+        ...     _ = h.add(vm.ModalEstimate(fn=[f], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001]), time=day * 86400.0)
+        >>> import tempfile, pathlib
+        >>> p = pathlib.Path(tempfile.mkdtemp()) / "h.h5"
+        >>> h.save(p)
+        >>> len(vm.History.load(p).entries)
+        3
+        """
         with _locked(path):
             if Path(path).is_file():
                 self._merge(History.load(path))
