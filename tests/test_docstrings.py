@@ -5,7 +5,6 @@ sample_data/ is). Like python-control's docstring test."""
 
 import doctest
 import inspect
-import os
 import re
 import warnings
 from pathlib import Path
@@ -30,9 +29,9 @@ def public_objects() -> dict:
             if inspect.isclass(obj) and issubclass(obj, (Exception, Warning)):
                 continue   # errors are documented by their one-line docstring
             out[f"{prefix}.{name}"] = obj
-            if inspect.isclass(obj):
-                for meth, f in vars(obj).items():
-                    if not meth.startswith("_") and inspect.isfunction(f):
+            if inspect.isclass(obj):   # its own methods and those it inherits from vibmeasure's mixins
+                for meth, f in inspect.getmembers(obj, inspect.isfunction):
+                    if not meth.startswith("_") and f.__module__.startswith("vibmeasure"):
                         out[f"{prefix}.{name}.{meth}"] = f
     return out
 

@@ -4,13 +4,12 @@ the stiffness change a frequency shift implies; baselines and trends per machine
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..core.errors import ParameterError
-from ..core.results import ModalEstimate
+from ..core.results import Comparison, ModalEstimate
 
 __all__ = ["compare", "Comparison", "History"]
 
@@ -49,94 +48,6 @@ def _pair(meas: ModalEstimate, pred: ModalEstimate, max_rel: float):
     return pairs, macm
 
 
-@dataclass(frozen=True)
-class Comparison:
-    """Paired modes with deviations and verdicts (``vm.compare``).
-
-    Parameters
-    ----------
-    rows : tuple of dict
-        One per paired mode: predicted and measured fn and zeta, deviations, dk/k, verdict.
-    verdict : str
-        The worst: "ok", "watch" or "alarm".
-    reason : str
-        Why, in words.
-    unpaired_measured, unpaired_predicted : tuple of float
-        Frequencies that found no partner.
-    settings : dict
-        The tolerances used.
-
-    Raises
-    ------
-    ParameterError
-        Never for a ``vm.compare`` result.
-
-    Examples
-    --------
-    >>> import vibmeasure as vm
-    >>> est = vm.ModalEstimate(fn=[10.0], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001])
-    >>> cmp = vm.compare(est, vm.ModalEstimate(fn=[10.5], zeta=[0.02]))
-    >>> cmp.verdict
-    'alarm'
-    """
-
-    rows: tuple
-    verdict: str
-    reason: str
-    unpaired_measured: tuple = ()
-    unpaired_predicted: tuple = ()
-    settings: dict = field(default_factory=dict)
-
-    def to_frame(self):
-        """One row per paired mode.
-
-        Returns
-        -------
-        pandas.DataFrame
-
-        Raises
-        ------
-        ParameterError
-            Never.
-
-        Examples
-        --------
-        >>> import vibmeasure as vm
-        >>> est = vm.ModalEstimate(fn=[10.0], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001])
-        >>> cmp = vm.compare(est, vm.ModalEstimate(fn=[10.5], zeta=[0.02]))
-        >>> len(cmp.to_frame())
-        1
-        """
-        import pandas as pd
-        return pd.DataFrame(list(self.rows))
-
-    def to_dict(self) -> dict:
-        """JSON-ready: verdict, reason, modes, unpaired_measured_hz, unpaired_predicted_hz, settings.
-
-        Returns
-        -------
-        dict
-
-        Raises
-        ------
-        ParameterError
-            Never.
-
-        Examples
-        --------
-        >>> import vibmeasure as vm
-        >>> est = vm.ModalEstimate(fn=[10.0], zeta=[0.02], fn_std=[0.01], zeta_std=[0.001])
-        >>> cmp = vm.compare(est, vm.ModalEstimate(fn=[10.5], zeta=[0.02]))
-        >>> cmp.to_dict()["verdict"]
-        'alarm'
-        """
-        from ..core.results import jsonable
-        return jsonable({"verdict": self.verdict, "reason": self.reason, "modes": list(self.rows),
-                          "unpaired_measured_hz": list(self.unpaired_measured),
-                          "unpaired_predicted_hz": list(self.unpaired_predicted), "settings": self.settings})
-
-    def __repr__(self) -> str:
-        return f"Comparison({self.verdict}: {self.reason})"
 
 
 def compare(measured, predicted, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.5, pair_rtol: float = 0.25,

@@ -8,7 +8,7 @@ envelope analysis cannot tell them apart: a spike is broadband, the kurtogram pi
 impulsive band, and spikes at a fixed interval make a comb in the envelope spectrum (every 1024
 samples at 12 kHz is 11.72 Hz, within 2 % of the 6205's cage frequency, whose 9th harmonic is BPFO).
 Measured on the 53 development fault records (``benchmarks/diagnosis_robustness.py``): 30 x the RMS
-every 1024 samples gave 7 wrong calls, five random ones a second left 5 of 39 right answers.
+every 1024 samples give 7 wrong calls unrepaired, five random ones a second leave 5 of 39 right answers.
 
 ``isolated_spikes`` finds them: a sample whose departure from the running median of 7 (the residual)
 is ``SPIKE_SIGMA`` times the residual's robust spread (MAD), ``SPIKE_LEVEL`` times the record's own,
@@ -132,9 +132,9 @@ def _spikes_once(x: np.ndarray, sigma: float, isolation: float) -> np.ndarray:
     if cand.size == 0:
         return np.zeros(0, np.int64)
     # a candidate is a single sample when both its neighbours stand ``isolation`` times lower (on a
-    # fault's impact a spike still does: 60-90 robust sigmas beside 15-25; the old rule, no neighbour a
-    # candidate at all, missed 1.7 % of random spikes on the CWRU fan-end channels, up to 49 of 500 on
-    # one, all of them on impacts). Two single ones within SPIKE_CONTEXT samples do not hide each
+    # fault's impact a spike still does: 60-90 robust sigmas beside 15-25; requiring instead that no
+    # neighbour be a candidate at all misses 1.7 % of random spikes on the CWRU fan-end channels, up to
+    # 49 of 500 on one, all of them on impacts). Two single ones within SPIKE_CONTEXT samples do not hide each
     # other (two spikes close together), but three or more comparable ones (each within ``isolation``
     # of the sample judged) are a burst: an impact ringing near Nyquist, every other sample far out
     pad = np.concatenate(([0.0], a, [0.0]))
@@ -322,8 +322,8 @@ def clipped_share(x) -> float:
     def piled(e):
         """More samples at the extreme than twice at the next value inside it (to within rounding): a
         rail. A noise-free periodic signal repeats its extreme once a period and the values beside it as
-        often or more (a sine with a whole number of samples per period: twice as often; before this
-        test every such test sine read as saturated), and the next code of a quantised signal that
+        often or more (a sine with a whole number of samples per period: twice as often; without this
+        test every such test sine reads as saturated), and the next code of a quantised signal that
         does not reach its rail is commoner than its top code."""
         inside = x[x < e] if e == hi else x[x > e]
         if inside.size == 0:

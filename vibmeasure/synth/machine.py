@@ -19,7 +19,8 @@ def _impact_train(n, fs, times, resonance_hz, amp=None):
     exact time by a band-limited fractional delay (a Kaiser-windowed sinc of 64 taps), as an
     anti-aliased measurement would see it. Rounded to samples, a train with 400.67 samples per period
     (a shaft's at 1797 rpm and 12 kHz) repeats its rounding every third impact, and its envelope has
-    lines at thirds of the shaft rate that no machine makes (healthy machines were called inner race)."""
+    lines at thirds of the shaft rate that no machine makes (a healthy machine with a rub then reads as
+    an inner race)."""
     wr = 2 * np.pi * resonance_hz
     tau = 1 / (0.05 * wr)
     t = np.asarray(times, dtype=float) * fs

@@ -50,15 +50,15 @@ def _decoy_p(ses: _SES, res: dict, f0: float, freqs: dict) -> float:
 # 2 x BSF of MFPT's bearing at 0.632 x its speed is its BPFO). A real fault at the right speed is not
 # outdone by its aliases: a comb at another speed that hits the same lines misses its sidebands or
 # pays for the wider search. Measured (benchmarks/diagnosis_robustness.py): the MFPT records, whose
-# 1X is too weak to contradict a wrong speed, declared 15 % slow, 20 % fast or 30 % slow gave 8 wrong
-# calls (BPFI - 2X and its multiples taken for BPFO at 15 % slow, p down to 1e-19); the inner race's
+# 1X is too weak to contradict a wrong speed, declared 15 % slow, 20 % fast or 30 % slow give 8 wrong
+# calls without the scan (BPFI - 2X and its multiples taken for BPFO at 15 % slow, p down to 1e-19); the inner race's
 # own comb with its sidebands stands where the true speed puts it, p = 1e-38. Every development record
 # at its declared speed with its 1X taken as not found (a scratch run forcing the scan): one is
 # contradicted, B007_1, a "none" record whose base channel carries a BPFI comb with +-1X sidebands of
-# a shaft 13.9 % faster (166.6 Hz +- 33.7 Hz). Before the two exclusions and the 1X-search range on
-# the declared side, noise at the records' RMS (which hides the 1X) turned 3 right calls into
-# "contradicted" (an inner race at +2.2 % read through BPFO's alias at 1.655 x, shaft harmonics read
-# as BSF x 0.5, 1, 1.5 at 0.501 x).
+# a shaft 13.9 % faster (166.6 Hz +- 33.7 Hz). The two exclusions and the 1X-search range on the
+# declared side are needed: without them, noise at the records' RMS (which hides the 1X) turns 3 right
+# calls into "contradicted" (an inner race at +2.2 % read through BPFO's alias at 1.655 x, shaft
+# harmonics read as BSF x 0.5, 1, 1.5 at 0.501 x).
 SPEED_SCAN = (0.5, 2.0)
 SPEED_SCAN_MARGIN = 1e-3
 

@@ -153,16 +153,15 @@ def _accepted(res: dict | None) -> bool:
     (five) times it, and neither is a frequency of this bearing.
 
     - Even harmonics: a 16-roller bearing's BPFO (the ZA-2115's, 7.09 X) stands 1 % under twice the
-      6205's (3.585 X). Synthetic ZA-2115 outer-race faults declared as a 6205 were called 6205 outer
-      race at 1.00 on every record. Of 144 synthetic faults diagnosed with a bearing whose defect
-      frequencies all differ by more than 3 %, 78 were called a fault, 44 with this rule; the right
-      bearing stays right on all 144 (benchmarks/diagnosis.py, "another bearing declared").
+      6205's (3.585 X): without this rule synthetic ZA-2115 outer-race faults declared as a 6205 read
+      as 6205 outer race at 1.00 on every record. Of 144 synthetic faults diagnosed with a bearing whose
+      defect frequencies all differ by more than 3 %, 44 are called a fault with this rule (78 without);
+      the right bearing stays right on all 144 (benchmarks/diagnosis.py, "another bearing declared").
     - A lone 3rd harmonic: CWRU fan-end outer-race records (6203) read with the drive end's 6205
-      declared were called 6205 inner race on 5 records. The 6203's 5 x BPFO with its +1X and +2X
-      sidebands (453, 483, 512 Hz on OR021@3_1) stood as the 6205's 3 x BPFI with its +-1X, nothing at
-      its 1st or 2nd harmonic. With this rule, bearing calls on the 49 CWRU records read with the other
-      end's bearing fell from 13 to 11 (four of those inner-race calls went; two records whose lines
-      the inner race no longer claims got other calls). On the development records, the synthetic
+      declared read as 6205 inner race on 5 records without this rule: the 6203's 5 x BPFO with its +1X
+      and +2X sidebands (453, 483, 512 Hz on OR021@3_1) stands as the 6205's 3 x BPFI with its +-1X,
+      nothing at its 1st or 2nd harmonic. With it, the 49 CWRU records read with the other end's
+      bearing give 11 bearing calls (13 without). On the development records, the synthetic
       benchmark and the 27 robustness variants no answer changed."""
     return bool(res and res["n_lines"] >= 2 and res["n_carriers"] >= 1 and res["logp"] < np.log(ALPHA)
                 and res.get("step", 1.0) <= 1.0
@@ -195,16 +194,15 @@ def _explain(ses: _SES, freqs: dict, f1: float, shaft_hz: float, f1_known: bool,
     has claimed (``_survives``), while the other still is once the first has. So a line goes to the
     family that explains it with the rest of its comb.
 
-    Without that test, an inner race whose carriers are weak and sidebands strong lost its sidebands:
+    Without that test, an inner race whose carriers are weak and sidebands strong loses its sidebands:
     in CWRU IR021_3's fan-end (or drive-end) channel alone, BPFI - 1X, 2 BPFI - 2X and 3 BPFI - 3X
-    (114.4, 228.8, 343.2 Hz) stood as the first three harmonics of 2 x BSF at -0.85 % slip (the
-    6203's 2 x BSF is 3.987 X, BPFI - 1X 3.947 X), and ball was called (p = 2e-15) beside an inner
-    race comb with its +-1X sidebands at p = 6e-28. Ordering by p-value alone instead fixed that, but
-    on 1 s pieces of single channels it let inner-race sideband combs take outer-race lines with their
+    (114.4, 228.8, 343.2 Hz) stand as the first three harmonics of 2 x BSF at -0.85 % slip (the
+    6203's 2 x BSF is 3.987 X, BPFI - 1X 3.947 X), and ball is called (p = 2e-15) beside an inner
+    race comb with its +-1X sidebands at p = 6e-28. Ordering by p-value alone avoids that, but on
+    1 s pieces of single channels it lets inner-race sideband combs take outer-race lines with their
     +-1X sidebands (the 6203's BPFO + BPFI is 8X, so both combs sit near whole orders and 1 Hz lines
-    cannot tell them apart): 10 wrong calls in 1350 pieces against 4. With the test: 4 (3 once a comb
-    at the slip range's edge is not called, ``_accepted``), and no wrong call on the 135 whole single
-    channels (2 before)."""
+    cannot tell them apart): 10 wrong calls in 1350 pieces. With the test: 3 (a comb at the slip
+    range's edge not called, ``_accepted``), and no wrong call on the 135 whole single channels."""
     _claim_shaft(ses, shaft_hz, f1_known, freqs, contested=shaft)
     ses.results["bearing_cage"] = _claim_cage(ses, freqs, f1, n_balls)
     ses.r_base = ses.r.copy()  # what the bearing families compete for (decoys are scored on it)

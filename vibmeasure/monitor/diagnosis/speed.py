@@ -14,27 +14,24 @@ from .lines import LINE_DB, _harmonic_support, _line, _lines_standing, _spectrum
 from .mains import _at_mains
 from .tracking import DRIFT_P, SPEED_DRIFT, _order_tracked_job, _speed_drift, _speed_from_1x
 
-# The 1X line is looked for this far (share) from the declared speed. An induction motor's speed under
-# load is up to about 5 % below its synchronous speed, a declared speed is often the nameplate's, and a
-# drive's set point may be further off. With +-3 % and the strongest line taken, CWRU OR014@3_0 declared
-# 4-5 % fast (1845-1863 against 1774 rpm) took a 17.5 dB line at 1880 rpm for the 1X (the true one, 52
-# dB, lay outside), and the 53 development records declared 5 % fast (slow) gave 13 (8) wrong calls.
-# Within the window the 1X is the line with the most harmonics (2X-6X, ``_harmonic_support``), then the
-# strongest: of the 57 development records declared 0.90-1.12 x their speed, the old rule (strongest line
-# within +-6 %) found the 1X of all 57 only from 0.97 to 1.03 x (none beyond 0.92 and 1.08 x), this one
-# of all 57 from 0.92 to 1.12 x (56 at 0.90 x, where IR007_1's 1X lies 13.8 % away), and at the declared
-# speed the same line as before on every record.
+# The 1X line is looked for within SPEED_SEARCH of the declared speed: an induction motor under load
+# runs up to about 5 % below its synchronous speed, a declared speed is often the nameplate's, and a
+# drive's set point may be further off (CWRU OR014@3_0 declared 4-5 % fast has its 1X, 52 dB, outside a
+# +-3 % window, and a 17.5 dB line inside it). Within the window the 1X is the line with the most
+# harmonics 2X-6X (``_harmonic_support``), then the strongest: a stronger line without harmonics
+# (another machine, a structure) is not the shaft's. Measured on the 57 development records declared
+# 0.90-1.12 x their speed: the 1X of all 57 is found from 0.92 to 1.12 x (56 at 0.90 x, where IR007_1's
+# 1X lies 13.8 % away); the strongest line within +-6 % alone finds all 57 only from 0.97 to 1.03 x.
 SPEED_SEARCH = 0.12
 SPEED_NOTED = 0.01   # a 1X this far from the declared speed is said so in the answer
 # A 1X candidate more than SPEED_NOTED from the declared speed confirms the speed it shows only with at
 # least ONE_X_CONFIRMS of its harmonics 2X-6X; with fewer, neither it nor the declared speed is confirmed
-# and the bearing's own lines are searched at other speeds, as when no 1X is found. MFPT's inner-race
-# record declared 20 % fast: a 12 dB line with one harmonic at 1919 rpm (+6.6 % from the declared 1800,
-# +28 % from the true speed) was taken for the 1X, and ball was called at p = 3e-15 on lines of the
-# inner race; now its comb with +-1X sidebands stands at 1488 rpm (true: 1486), p = 2e-58, and the speed
-# is contradicted. Every development record keeps its answer, and of the 36 robustness variants only
-# that one changes (the 1X of the MFPT records at their declared speed has 1-3 harmonics, within 1.2 %
-# of it). A speed measured by a tachometer or a profile is confirmed as it is.
+# and the bearing's own lines are searched at other speeds, as when no 1X is found. Reason: MFPT's
+# inner-race record declared 20 % fast shows a 12 dB line with one harmonic at 1919 rpm (+28 % from the
+# true speed); taken for the 1X it leads to a ball call (p = 3e-15) on the inner race's lines, while the
+# scan finds the inner race's comb with +-1X sidebands at 1488 rpm (true 1486), p = 2e-58. At their
+# declared speed the MFPT records' 1X shows 1-3 harmonics within 1.2 % of it. A speed measured by a
+# tachometer or a profile is confirmed as it is.
 ONE_X_CONFIRMS = 2
 
 
@@ -96,15 +93,14 @@ def _speed(job: Job, f, A):
     return speed, f1
 
 
-# A declared speed further off than SPEED_SEARCH finds no 1X, or a wrong line, and the bearing lines fall at
-# wrong orders: the 53 development records declared at 0.88 x their speed gave 16 wrong calls (first
-# channel as the primary one). The record contradicts such a speed when a shaft comb stands elsewhere
-# (OTHER_SHAFT x the declared speed): a line
-# at least OTHER_SHAFT_DB above the window's 1X (or the level there when none stands out) with at least
-# OTHER_SHAFT_HARMONICS of its harmonics 2X-6X, more than that 1X has, and no harmonic or sub-harmonic
-# of it. Measured (benchmarks/diagnosis_robustness.py, and scratch sweeps of every channel): at the
-# declared speed no development record and no 1 s or 2 s piece of one is flagged (only Normal_0, whose
-# declared fs is already caught); at 0.85 x and 1.2 x, 90 % of the 1 s pieces are.
+# A declared speed further off than SPEED_SEARCH finds no 1X, or a wrong line, and puts the bearing
+# lines at wrong orders (the 53 development records declared at 0.88 x their speed: 16 wrong calls
+# without this check). The record contradicts such a speed when a shaft comb stands elsewhere
+# (OTHER_SHAFT x the declared speed): a line at least OTHER_SHAFT_DB above the window's 1X (or the level
+# there when none stands out) with at least OTHER_SHAFT_HARMONICS of its harmonics 2X-6X, more than
+# that 1X has, and no harmonic or sub-harmonic of it. Measured (benchmarks/diagnosis_robustness.py):
+# at the declared speed no development record and no 1 s or 2 s piece of one is flagged (Normal_0's
+# wrong declared fs is caught before); at 0.85 x and 1.2 x, 90 % of the 1 s pieces are.
 OTHER_SHAFT = (0.5, 2.0)
 OTHER_SHAFT_DB = 10.0
 OTHER_SHAFT_HARMONICS = 4

@@ -1,0 +1,89 @@
+"""What every result shares: the sentence for each quality flag, and the one conversion to JSON."""
+
+from __future__ import annotations
+
+import math
+from typing import Mapping
+
+import numpy as np
+
+from ..errors import ParameterError
+
+# Every quality flag a result may carry, with the sentence a report prints for it.
+FLAG_TEXT = {
+    "few_cycles": "fewer than 5 cycles of decay above the noise: damping is poorly determined",
+    "noise_floor": "the decay reached the noise floor before the record ended; the fit stops there",
+    "resolution_limited": "sampling or frequency resolution too coarse for a sound estimate",
+    "clipped": "clipped samples (3 or more in a row at the extreme) were excluded",
+    "close_modes": "another mode lies within a few half-power bandwidths: estimates interact",
+    "overdamped": "no oscillation: the system is critically or over damped (zeta >= 1); no frequency",
+    "coulomb_friction": "the envelope decays linearly, as with dry (Coulomb) friction: viscous zeta does "
+                        "not describe it; see friction decay per cycle",
+    "amplitude_dependent": "damping changes with amplitude (nonlinear damping); zeta is an average",
+    "amplitude_dependent_frequency": "the natural frequency changes with amplitude (nonlinear stiffness); fn is "
+                                     "an average: see extras['backbone'] and extras['backbone_model']",
+    "colored_noise": "the noise near this mode is stronger than the broadband level: std scaled up",
+    "low_snr": "the mode is weak compared with the noise",
+    "start_detected": "the decay starts after the beginning of the record (trigger/impact found)",
+    # machine diagnosis
+    "bearing_not_checked": "no bearing given: bearing faults were not searched",
+    "band_limited": "a channel measures only up to a filter's edge, too low to demodulate above the shaft "
+                    "harmonics: the bearing evidence is weak",
+    "speed_varies": "the 1X line moves over the record and the speed was not measured: where the 1X follows "
+                    "a curve the speed is estimated from it and the record analysed in orders; else the lines "
+                    "smear and no shaft-order fault is called",
+    "order_tracked": "the speed varies: the record was resampled at equal steps of shaft angle and analysed in "
+                     "orders",
+    "spikes_removed": "isolated spikes (single samples, or two, far from their neighbours, which no accelerometer "
+                      "behind an anti-alias filter makes) were replaced by their AR interpolation",
+    "dropouts": "runs of equal samples (a converter or link that held or zeroed its output): the vibration "
+                "there is lost; they were filled by AR interpolation for the envelope analysis",
+    "saturated": "runs of samples sit at the record's extremes: the sensor or converter saturated, the level "
+                 "reads low and the clipping adds harmonics",
+}
+
+
+def _arr(x, n, name, fill=np.nan):
+    if x is None:
+        return np.full(n, fill)
+    a = np.atleast_1d(np.asarray(x, dtype=float))
+    if a.shape != (n,):
+        raise ParameterError(f"{name} must have one value per mode ({n}), got shape {a.shape}")
+    return a
+
+
+def _num(x):
+    x = float(x)
+    return None if not np.isfinite(x) else x
+
+
+_PLAIN = (str, int, bool, type(None))
+
+
+def jsonable(obj):
+    """obj with numpy scalars and arrays, tuples, NaN and inf turned into what ``json.dumps`` writes
+    (lists, floats, None): the one conversion every ``to_dict`` and the CLI's ``--json`` use."""
+    t = type(obj)
+    if t in _PLAIN:   # the common leaves first: no abstract-class checks (a batch converts ~10^5 values)
+        return obj
+    if t is float:
+        return obj if math.isfinite(obj) else None
+    if t is dict:
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if t is list or t is tuple:
+        return [jsonable(v) for v in obj]
+    if hasattr(obj, "to_dict") and hasattr(obj, "columns"):  # a pandas DataFrame: its rows
+        return [jsonable(r) for r in obj.to_dict(orient="records")]
+    if isinstance(obj, Mapping):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return [jsonable(v) for v in obj.tolist()]
+    if isinstance(obj, (float, np.floating)):
+        return _num(obj)
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (np.bool_,)):
+        return bool(obj)
+    return obj
