@@ -444,3 +444,25 @@ def test_uff_truncated(tmp_path, shared_data):
     bad.write_bytes(src[: len(src) // 3])
     with pytest.raises(vm.ParameterError, match="unreadable|truncated|no dataset 58|differ"):
         vm.read(bad)
+
+
+def test_whitespace_separated_columns_are_read(tmp_path):
+    """Loggers and OMA datasets write numbers in columns separated by runs of spaces (.asc, .txt): read
+    exactly, with or without a header and leading spaces; ``delimiter=`` forces a separator, and a
+    wrong one is named."""
+    (tmp_path / "log.asc").write_text("acc1 acc2 acc3\n 0.125  -1.5e-3   7\n 0.250   2.0e-3  -8\n-0.375   1.0e-3   9\n")
+    rec = vm.read(tmp_path / "log.asc", fs=100.0)
+    assert rec.names == ["acc1", "acc2", "acc3"]
+    np.testing.assert_array_equal(rec.data[1], [-1.5e-3, 2.0e-3, 1.0e-3])
+    (tmp_path / "plain.txt").write_text("  1.5   2.5\n  3.5   4.5\n  5.5   6.5\n")
+    rec = vm.read(tmp_path / "plain.txt", fs=10.0)
+    np.testing.assert_array_equal(rec.data, [[1.5, 3.5, 5.5], [2.5, 4.5, 6.5]])
+    (tmp_path / "comma.txt").write_text("1,5  2,5\n3,5  4,5\n")     # decimal comma between spaces
+    np.testing.assert_array_equal(vm.read(tmp_path / "comma.txt", fs=10.0).data, [[1.5, 3.5], [2.5, 4.5]])
+    (tmp_path / "semi.txt").write_text("1.5;2.5\n3.5;4.5\n")
+    assert vm.read(tmp_path / "semi.txt", fs=10.0, delimiter=";").n_channels == 2
+    with pytest.raises(vm.ParameterError, match="delimiter='[|]' must be one of"):
+        vm.read(tmp_path / "plain.txt", fs=10.0, delimiter="|")
+    vm.write(tmp_path / "r.h5", rec)
+    with pytest.raises(vm.ParameterError, match="applies to text files"):
+        vm.read(tmp_path / "r.h5", delimiter=",")

@@ -181,9 +181,11 @@ def test_bad_input():
     with pytest.raises(vm.ParameterError, match="band"):
         vm.oma_ssi(rec, band=(10, 150))
     with pytest.raises(vm.ParameterError, match="band"):
-        vm.oma_fdd(rec, band=None)
+        vm.oma_fdd(rec, band=(10, 150))
+    with pytest.raises(vm.ParameterError, match=r"minimum duration of 100 s"):   # even the band's top: 100 cycles
+        vm.oma_ssi(rec, band=(0.2, 1.0))
     with pytest.raises(vm.ParameterError, match=r"minimum duration of 100 s"):
-        vm.oma_ssi(rec, band=(1, 80))
+        vm.oma_fdd(rec, band=(0.2, 1.0))
     with pytest.raises(vm.ParameterError, match="block_rows"):
         vm.oma_ssi(rec, block_rows=2)
     bad = rec.data.copy()
@@ -230,3 +232,22 @@ def test_cli_oma(tmp_path):
     out = io.StringIO()
     assert main(["oma", str(path), "--method", "fdd", "--band", "1", "80"], out=out, err=io.StringIO()) == 0
     assert "oma_fdd" in out.getvalue()
+
+
+def test_the_duration_rule_is_on_the_modes_and_fdd_has_ssis_defaults():
+    """A record of 10 s holds 89 cycles of the 8.89 Hz mode: it is identified and flagged few_cycles (its
+    damping rests on fewer than the 100 cycles the rule asks), while the band's lower edge (1 Hz, which
+    would ask 100 s) refuses nothing. oma_fdd takes the same defaults as oma_ssi (no band: the whole
+    range) and lists what it refused under the one documented key, rejected_modes."""
+    model, sensors = system()
+    short = vm.synth.ambient(model, fs=200.0, duration=10.0, outputs=sensors, seed=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ssi = vm.oma_ssi(short, band=(1, 80), n_blocks=5)   # 10 s: five jackknife blocks
+        fdd = vm.oma_fdd(vm.synth.ambient(model, fs=200.0, duration=60.0, outputs=sensors, seed=1))
+    low = int(np.argmin(np.abs(ssi.fn - 8.89)))
+    assert abs(ssi.fn[low] - 8.89) < 0.1 and "few_cycles" in ssi.mode_flags[low]
+    assert all("few_cycles" not in fl for f, fl in zip(ssi.fn, ssi.mode_flags) if f * 10.0 >= 100)
+    assert fdd.n_modes >= 3 and fdd.extras["rejected_modes"] is fdd.extras["rejected_peaks"]
+    true = model.modes().fn
+    assert (np.min(np.abs(fdd.fn[:, None] - true[None, :]), axis=1) / fdd.fn).max() < 0.01   # each a true mode

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from ..core.errors import VibMeasureError
 from ._common import emit_json, plot_module, print_warnings, quality_warnings, save_figure
 
 
@@ -16,7 +15,7 @@ def register(sub) -> None:
                     help="ssi: covariance-driven stochastic subspace identification (default); fdd: frequency-"
                          "domain decomposition with EFDD damping")
     om.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"),
-                    help="frequency band (Hz); required for fdd")
+                    help="frequency band (Hz); default the whole range")
     om.add_argument("--channel", action="append", help="output channel(s) (default: all that are not forces)")
     om.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
     om.add_argument("--max-order", type=int, default=40, help="ssi: highest model order (default 40)")
@@ -38,10 +37,8 @@ def run(args, out, err) -> int:
         if args.method == "ssi":
             est = oma_ssi(rec, band=band, max_order=args.max_order, block_rows=args.block_rows)
         else:
-            if band is None:
-                raise VibMeasureError("--method fdd needs --band LO HI")
             est = oma_fdd(rec, band=band, nperseg=args.nperseg)
-    rejected = est.extras.get("rejected_modes" if args.method == "ssi" else "rejected_peaks", [])
+    rejected = est.extras.get("rejected_modes", [])
     if args.json:
         from ..core.results import jsonable
         doc = {"command": "oma", "file": str(args.file), "fs_hz": rec.fs, **est.to_dict(), "warnings": msgs}

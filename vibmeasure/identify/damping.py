@@ -521,15 +521,20 @@ def half_power_frf(obj, *, band=None, output=0, input=0) -> ModalEstimate:
                              f"got {type(obj).__name__}")
     if form == "unknown":
         form = "receptance"
-    if not np.isfinite(P).all():
-        raise ParameterError("the FRF/spectrum has NaN/inf lines")
     sel = np.ones(freq.size, bool) if band is None else (freq >= band[0]) & (freq <= band[1])
     sel &= freq > 0
     if not sel.any():
         raise ParameterError(f"band={band!r} holds no line of the data")
+    # NaN lines outside the band (a swept sine leaves them where it had no power) do not matter
+    finite = np.isfinite(P)
+    if not finite[sel].all():
+        raise ParameterError(f"the FRF/spectrum has NaN/inf lines inside band={band!r}: narrow the band")
     k = int(np.flatnonzero(sel)[np.argmax(P[sel])])
     f1, f2, lo, hi = half_power_crossings(freq, P, k, lower_msg="the lower half-power point does not exist "
                                           "(zeta > 0.38, or the peak sits at the start of the data)")
+    if not finite[lo:hi + 1].all():
+        raise ParameterError(f"the half-power band of the peak at {freq[k]:.6g} Hz reaches NaN/inf lines: the data "
+                             "around the peak is incomplete")
     df = float(freq[1] - freq[0])
     lines = (f2 - f1) / df
     if lines < 3:

@@ -20,7 +20,7 @@ from .wav import read_wav, write_wav
 
 __all__ = ["read", "write", "open_record", "LazyRecord", "FORMATS", "read_frf", "read_spectrum"]
 
-_READERS = {".csv": read_csv, ".txt": read_csv, ".tsv": read_csv, ".h5": read_hdf5, ".hdf5": read_hdf5,
+_READERS = {".csv": read_csv, ".txt": read_csv, ".tsv": read_csv, ".asc": read_csv, ".h5": read_hdf5, ".hdf5": read_hdf5,
             ".wav": read_wav, ".mat": read_mat, ".lvm": read_lvm, ".uff": read_uff, ".unv": read_uff}
 _WRITERS = {".csv": write_csv, ".h5": write_hdf5, ".hdf5": write_hdf5, ".wav": write_wav}
 FORMATS = tuple(sorted(_READERS))
@@ -28,10 +28,10 @@ FORMATS = tuple(sorted(_READERS))
 
 def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, quantity: str | None = None,
          unit: str | None = None, dataset: str | None = None, max_samples: int = DEFAULT_MAX_SAMPLES,
-         allow_external: bool = False) -> Record:
+         allow_external: bool = False, delimiter: str | None = None) -> Record:
     """Read a measurement file into a :class:`Record`.
 
-    The format follows the ending: .csv/.txt/.tsv, .h5/.hdf5, .wav, .mat (v5 and v7.3), .lvm, .uff/.unv;
+    The format follows the ending: .csv/.txt/.tsv/.asc, .h5/.hdf5, .wav, .mat (v5 and v7.3), .lvm, .uff/.unv;
     a file whose ending names none of them (the IMS rig's 2004.02.12.10.32.39) is recognised by its
     content (signature, or lines of delimited numbers). A damaged, truncated or contradictory file
     raises ParameterError naming the file and the rule (a CSV whose last line has no end of line drops
@@ -57,6 +57,9 @@ def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, qua
     allow_external : bool
         Accept HDF5 external storage and links that leave the file (refused by default: they can read
         any local file as samples).
+    delimiter : {",", ";", "tab", "whitespace"}, optional
+        The field separator of a text file (default: found from its lines: a tab, a semicolon or a
+        comma where the lines hold one, else runs of whitespace, as loggers write .asc and .txt).
 
     Returns
     -------
@@ -96,6 +99,13 @@ def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, qua
         kw.update(dataset=dataset, allow_external=bool(allow_external))
     elif dataset is not None:
         raise ParameterError(f"dataset={dataset!r} applies to HDF5 files only, not {ext!r}")
+    if delimiter is not None:
+        from .csvfile import DELIMITERS
+        if _READERS[ext] is not read_csv:
+            raise ParameterError(f"delimiter={delimiter!r} applies to text files (.csv .txt .tsv .asc), not {ext!r}")
+        if delimiter not in DELIMITERS:
+            raise ParameterError(f"delimiter={delimiter!r} must be one of ',', ';', 'tab' or 'whitespace'")
+        kw.update(delimiter=delimiter)
     return guarded(_READERS[ext], p, kind=ext, **kw)
 
 

@@ -24,13 +24,25 @@ def _split_name_unit(label: str) -> tuple[str, str | None]:
     return (m.group(1), m.group(2)) if m else (label.strip(), None)
 
 
-def _sniff(lines: list[str]) -> tuple[str, str]:
-    """Delimiter and decimal mark from the first data lines."""
+WHITESPACE = r"\s+"   # runs of spaces (or tabs mixed with spaces): the loggers' and OMA datasets' .asc/.txt
+DELIMITERS = {",": ",", ";": ";", "\t": "\t", "tab": "\t", " ": WHITESPACE, "space": WHITESPACE,
+              "whitespace": WHITESPACE}
+
+
+def _sniff(lines: list[str], delimiter=None) -> tuple[str, str]:
+    """Delimiter and decimal mark from the first data lines (or the caller's ``delimiter``): a tab, a
+    semicolon or a comma where the lines hold one, else runs of whitespace between fields."""
     sample = "\n".join(lines[:20])
-    if "\t" in sample:
+    if delimiter is not None:
+        sep = DELIMITERS[delimiter]
+    elif "\t" in sample:
         sep = "\t"
     elif ";" in sample:
         sep = ";"
+    elif "," in sample and not re.search(r"\d,\d+[ \t]+[-+]?\d", sample):   # not a decimal comma between spaces
+        sep = ","
+    elif any(re.search(r"\S[ \t]+\S", ln.strip()) for ln in lines[:20]):
+        sep = WHITESPACE
     else:
         sep = ","
     decimal = "."
@@ -38,6 +50,10 @@ def _sniff(lines: list[str]) -> tuple[str, str]:
         if re.search(r"\d,\d", sample) and not re.search(r"\d\.\d", sample):
             decimal = ","
     return sep, decimal
+
+
+def _fields(line: str, sep: str) -> list:
+    return line.split() if sep == WHITESPACE else line.split(sep)
 
 
 def _cut_last_line(text: str, src: str) -> str:
@@ -70,7 +86,8 @@ def _check_digest(text: str, src: str) -> None:
                              "cut or edited file)")
 
 
-def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
+def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES,
+             delimiter=None) -> Record:
     src = f"CSV file {str(path)!r}"
     try:
         text = Path(path).read_text(encoding="utf-8-sig")
@@ -78,7 +95,7 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
         raise ParameterError(f"{src} is not UTF-8 text: unreadable as CSV") from None
     _check_digest(text, src)
     header_kv, chan_meta, body = _header_and_body(_cut_last_line(text, src).splitlines(), src)
-    values, labels, has_header = _table(body, src, max_samples)
+    values, labels, has_header = _table(body, src, max_samples, delimiter)
     _check_rows(values, has_header, header_kv, src)
     split = [_split_name_unit(lab) for lab in labels]
     names, units = [nm for nm, _ in split], [un for _, un in split]
@@ -128,12 +145,12 @@ def _header_and_body(lines: list, src: str) -> tuple[dict, dict, list]:
     return header_kv, chan_meta, body
 
 
-def _table(body: list, src: str, max_samples) -> tuple:
+def _table(body: list, src: str, max_samples, delimiter=None) -> tuple:
     """(values (n_rows, n_columns), column labels, whether the first row is a header): separator and
     decimal mark sniffed, sizes checked before pandas reads anything."""
     import pandas as pd
-    sep, decimal = _sniff(body[1:] if len(body) > 1 else body)
-    first = body[0].split(sep)
+    sep, decimal = _sniff(body[1:] if len(body) > 1 else body, delimiter)
+    first = _fields(body[0], sep)
     if len(first) > MAX_CHANNELS:
         raise ParameterError(f"{src}: its first row has {len(first):,} fields, above the limit of {MAX_CHANNELS:,} "
                              "channels")
@@ -148,7 +165,7 @@ def _table(body: list, src: str, max_samples) -> tuple:
                                  "with a comma separator is ambiguous: use ';' or tab as separator")
     try:
         df = pd.read_csv(io.StringIO("\n".join(body)), sep=sep, decimal=decimal,
-                         header=0 if has_header else None, skipinitialspace=True, engine="c")
+                         header=0 if has_header else None, skipinitialspace=sep != WHITESPACE, engine="c")
     except Exception as exc:  # pandas raises many types for malformed text
         raise ParameterError(f"{src} is not readable as CSV: {exc}") from None
     df = df.dropna(axis=1, how="all")  # trailing separators

@@ -75,9 +75,12 @@ def band_kurtosis(Y, fs, f0, half_width, shape=None) -> float:
     return float(np.mean(x ** 4) / p2 ** 2) if p2 > 0 else float("nan")
 
 
-def _check_duration(n: int, fs: float, f_lo: float, what: str):
-    need = MIN_CYCLES / f_lo
+def _check_duration(n: int, fs: float, f_hi: float, what: str):
+    """The record must hold MIN_CYCLES cycles of the band's top: below that no mode in the band can be
+    identified. A mode the record holds fewer cycles of is flagged ``few_cycles`` (its damping is
+    poorly determined), not refused: the rule is on the modes, not on the band's lower edge."""
+    need = MIN_CYCLES / f_hi
     if n / fs < need:
-        raise ParameterError(f"{what}: the record lasts {n / fs:.4g} s; the lowest frequency of interest, "
-                             f"{f_lo:.4g} Hz, needs at least {MIN_CYCLES} cycles: a minimum duration of {need:.4g} s "
-                             f"(1000 cycles, {10 * need:.4g} s, for damping within a few %)")
+        raise ParameterError(f"{what}: the record lasts {n / fs:.4g} s; even the band's top, {f_hi:.4g} Hz, needs "
+                             f"at least {MIN_CYCLES} cycles for a damping estimate: a minimum duration of {need:.4g} s "
+                             f"(1000 cycles of the lowest mode, for damping within a few %)")

@@ -16,7 +16,7 @@ from ...core.record import Record
 from ...core.results import ModalEstimate
 from ..limits import MAX_REL_ZETA_STD
 from ..shapes import mac_pair, mpc
-from ._common import N_GROUPS, TONE_KURTOSIS, _check_duration, _normalise, _outputs, band_kurtosis
+from ._common import MIN_CYCLES, N_GROUPS, TONE_KURTOSIS, _check_duration, _normalise, _outputs, band_kurtosis
 
 __all__ = ["oma_fdd"]
 
@@ -203,7 +203,7 @@ def _analytic(x):
 
 
 @single_threaded
-def oma_fdd(rec, *, band, nperseg: int | None = None, channels=None, n_modes: int | None = None,
+def oma_fdd(rec, *, band=None, nperseg: int | None = None, channels=None, n_modes: int | None = None,
             min_prominence_db: float = 6.0, mac_bell: float = 0.8) -> ModalEstimate:
     """Modes from output-only data by frequency-domain decomposition, damping by EFDD.
 
@@ -212,14 +212,16 @@ def oma_fdd(rec, *, band, nperseg: int | None = None, channels=None, n_modes: in
     surroundings, its singular vector is coherent around it and its band is a random response. EFDD
     takes each mode's bell (lines whose singular vector matches, MAC >= ``mac_bell``) back to a free
     decay, fitted by ``vm.ringdown``, with the bias of cutting the bell removed; stds from a jackknife
-    over segment groups. Refused peaks are in ``extras["rejected_peaks"]`` (docs/methods/oma.md).
+    over segment groups. Refused peaks are in ``extras["rejected_modes"]`` with the reason, as for
+    oma_ssi and fit_modes (``extras["rejected_peaks"]`` is the same list). A mode the record holds fewer
+    than 100 cycles of is flagged ``few_cycles`` (docs/methods/oma.md).
 
     Parameters
     ----------
     rec : Record
         Responses of one or more sensors.
-    band : tuple of float
-        (lo, hi) Hz.
+    band : tuple of float, optional
+        (lo, hi) Hz (default the whole range, as ``oma_ssi``).
     nperseg : int, optional
         Segment length of the cross-spectra.
     channels : list, optional
@@ -261,11 +263,8 @@ def oma_fdd(rec, *, band, nperseg: int | None = None, channels=None, n_modes: in
             from None
     if not (np.isfinite(min_prominence_db) and min_prominence_db > 0):
         raise ParameterError(f"min_prominence_db={min_prominence_db!r} must be a positive number of dB")
-    if band is None:
-        raise ParameterError("oma_fdd: band=(lo, hi) in Hz is required: the range to search for modes")
-    band = check_band(band, rec.fs)
-    if band[0] > 0:
-        _check_duration(Y.shape[1], rec.fs, band[0], "oma_fdd")
+    band = check_band(band, rec.fs) or (0.0, rec.fs / 2)   # the same default as oma_ssi: the whole range
+    _check_duration(Y.shape[1], rec.fs, band[1], "oma_fdd")
     nper = _fdd_nperseg(nperseg, Y.shape[1])
     if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer))
                                 or n_modes < 1):
@@ -344,6 +343,8 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
             continue
         if len(lines) < 5:
             fl.append("resolution_limited")
+        if "few_cycles" not in fl and vals[0] * rec.n_samples / rec.fs < MIN_CYCLES:
+            fl.append("few_cycles")   # its damping rests on fewer cycles than the rule asks
         for lst, v in zip((fn, zeta, fn_std, zeta_std), vals):
             lst.append(float(v))
         flags.append(tuple(fl))
@@ -358,7 +359,7 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
     picked = kept
     phi = _normalise(np.column_stack([U[c["line"], :, c["sv"]] for c in picked]))
     show = (f >= max(0.0, band[0] - 0.1 * (band[1] - band[0]))) & (f <= band[1] + 0.1 * (band[1] - band[0]))
-    extras = {"peaks": picked, "rejected_peaks": rejected, "bells": bells, "band_hz": list(band), "nperseg": nper,
+    extras = {"peaks": picked, "rejected_modes": rejected, "rejected_peaks": rejected, "bells": bells, "band_hz": list(band), "nperseg": nper,
               "n_segments": n_seg, "outputs": names, "mpc": mpc(phi).tolist(), "mac": np.abs(_mac_matrix(phi)).tolist(),
               "singular_values": {"freq": f[show], "values": S[show].T, "unit": f"({rec.channels[0].unit})^2/Hz"},
               "rule": "peaks of the singular values standing min_prominence_db out, coherent singular vector "

@@ -290,8 +290,7 @@ def oma_ssi(rec, *, band=None, max_order: int = 40, block_rows: int | None = Non
     l = Y.shape[0]
     band = check_band(band, rec.fs) or (0.0, rec.fs / 2)
     orders, s, n_blocks = _ssi_sizes(max_order, block_rows, n_blocks, l)
-    if band[0] > 0:
-        _check_duration(Y.shape[1], rec.fs, band[0], "oma_ssi")
+    _check_duration(Y.shape[1], rec.fs, band[1], "oma_ssi")
     Yd, fs_d, q = _decimate(Y, rec.fs, band if band[1] < rec.fs / 2 else None)
     if Yd.shape[1] < 8 * n_blocks * s:
         # each jackknife block must hold several times the 2 s lags of the covariances
