@@ -1,5 +1,7 @@
 """Classic damping estimates (log decrement, Hilbert envelope, half-power) against closed forms."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -73,13 +75,37 @@ def test_hilbert_refuses_when_decay_is_shorter_than_filter_transient():
         vm.hilbert_decay(rec)
 
 
-@pytest.mark.parametrize("zeta,tol", [(0.01, 1e-3), (0.05, 5e-3)])
-def test_half_power_of_decay_spectrum(zeta, tol):
-    # the Lorentzian half-power relation ignores the negative-frequency image: error grows ~ zeta^2 / ...
-    rec = vm.synth.free_decay(fn=10.37, zeta=zeta, fs=1000.0, duration=10.0)
-    est = vm.half_power(rec)
-    assert est.zeta[0] == pytest.approx(zeta, rel=tol)
-    assert np.isnan(est.zeta_std[0])  # the method gives no statistical std
+@pytest.mark.parametrize("zeta,tol", [(0.01, 1e-5), (0.05, 1e-5), (0.1, 1e-5), (0.2, 2e-3)])
+def test_half_power_of_decay_spectrum_is_unbiased(zeta, tol):
+    """The Lorentzian half-power relation ignores the mirror term at -wd: uncorrected, fn reads +1 % and
+    zeta -1.5 % at zeta 0.1, +3.5 % and -6 % at 0.2 (measured). The bias found on the exact decay at the
+    estimate is removed: noise-free, within 1e-5 through zeta 0.1 at every phase, 0.2 % at 0.2."""
+    for phase in (0.0, 0.7, 1.5, 2.5):
+        rec = vm.synth.free_decay(fn=10.37, zeta=zeta, fs=1000.0, duration=10.0, phase=phase)
+        est = vm.half_power(rec)
+        assert est.zeta[0] == pytest.approx(zeta, rel=tol)
+        assert est.fn[0] == pytest.approx(10.37, rel=tol)
+
+
+def test_half_power_std_matches_its_scatter_and_drift_is_removed():
+    """The std comes from the noise in the lines at the crossings and in the peak that sets the half
+    level (first order): over 60 seeds at 40 dB its ratio to the RMS error lies within 0.7-1.4 (measured
+    0.83-1.09 for zeta 0.005-0.2 over 100 seeds). An offset with a drift of 0.1 units/s, which made the
+    drift the strongest 'peak', changes nothing."""
+    errs, stds = [], []
+    for seed in range(60):
+        rec = vm.synth.free_decay(fn=10.0, zeta=0.02, fs=1000.0, duration=20.0, snr_db=40, seed=seed)
+        est = vm.half_power(rec)
+        errs.append(est.zeta[0] - 0.02)
+        stds.append(est.zeta_std[0])
+    ratio = np.sqrt(np.mean(np.square(errs))) / np.mean(stds)
+    assert 0.7 < ratio < 1.4
+    clean = vm.synth.free_decay(fn=10.0, zeta=0.05, fs=1000.0, duration=10.0, snr_db=40, seed=1)
+    drifting = vm.synth.free_decay(fn=10.0, zeta=0.05, fs=1000.0, duration=10.0, snr_db=40, seed=1, dc_offset=0.1,
+                                   drift=0.1)
+    assert vm.half_power(drifting).zeta[0] == pytest.approx(vm.half_power(clean).zeta[0], rel=1e-3)
+    with pytest.raises(vm.FitError, match="above 0.2"):
+        vm.half_power(vm.synth.free_decay(fn=10.0, zeta=0.21, fs=1000.0, duration=10.0))
 
 
 def test_half_power_refuses_truncated_decay():
@@ -136,3 +162,23 @@ def test_half_power_of_an_frf_ignores_nan_lines_outside_its_band():
     assert vm.half_power(h, band=(20, 40)).zeta[0] == pytest.approx(0.02, rel=1e-3)
     with pytest.raises(vm.ParameterError, match="NaN/inf lines inside band"):
         vm.half_power(h, band=(1, 40))
+
+
+def test_log_decrement_flags_several_modes_in_its_band():
+    """A second decaying mode makes the cycle extremes beat and the decrement mixes both: 25 Hz beside
+    10 Hz at half its amplitude reads zeta about 11 % high (measured 10.8 % over 10 seeds), and is
+    flagged several_modes with the other mode named; the same record in a band around 10 Hz, and a
+    single-mode decay, are not flagged (a flag that is never raised on one mode is worth reading)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        two = vm.synth.free_decay(fn=[10.0, 25.0], zeta=[0.02, 0.02], amplitude=[1.0, 0.5], fs=1000.0,
+                                  duration=10.0, snr_db=40, seed=3)
+        mixed = vm.log_decrement(two)
+        banded = vm.log_decrement(two, band=(5, 15))
+        one = vm.log_decrement(vm.synth.free_decay(fn=10.0, zeta=0.002, fs=1000.0, duration=10.0, snr_db=20, seed=3))
+    assert "several_modes" in mixed.flags and any(abs(f - 25.0) < 0.3 for f in mixed.extras["other_modes_hz"])
+    assert mixed.zeta[0] > 1.05 * 0.02                       # the bias the flag warns of
+    assert "several_modes" not in banded.flags and banded.zeta[0] == pytest.approx(0.02, rel=0.03)
+    assert "several_modes" not in one.flags                 # a light decay cut by the record's end
+    with pytest.warns(vm.QualityWarning, match="several_modes"):
+        vm.log_decrement(two)

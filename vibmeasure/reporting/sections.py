@@ -15,6 +15,7 @@ FLAG_ADVICE = {
     "resolution_limited": "record longer (finer lines) or sample faster, or use the time-domain fit (vm.ringdown)",
     "clipped": "lower the sensor gain or the excitation: clipped samples carry no information",
     "close_modes": "treat fn and zeta of these modes with care; more outputs or a longer record separate them",
+    "several_modes": "give band= around one mode, or use vm.ringdown, which fits every mode at once",
     "overdamped": "no natural frequency can be measured; check the sensor and the excitation",
     "coulomb_friction": "describe the damping by the friction decay per cycle, not by a viscous zeta",
     "amplitude_dependent": "quote zeta with its amplitude (see the backbone table), not as one number",

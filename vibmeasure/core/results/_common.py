@@ -16,6 +16,7 @@ FLAG_TEXT = {
     "resolution_limited": "sampling or frequency resolution too coarse for a sound estimate",
     "clipped": "clipped samples (3 or more in a row at the extreme) were excluded",
     "close_modes": "another mode lies within a few half-power bandwidths: estimates interact",
+    "several_modes": "the analysed band holds more than one decaying mode: the decrement mixes them",
     "overdamped": "no oscillation: the system is critically or over damped (zeta >= 1); no frequency",
     "coulomb_friction": "the envelope decays linearly, as with dry (Coulomb) friction: viscous zeta does "
                         "not describe it; see friction decay per cycle",

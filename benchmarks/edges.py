@@ -1,0 +1,128 @@
+"""The estimators at the edges of their validity (issue 45): each case as a user meets it, and the figure
+vibmeasure gives. Run it on an older checkout (PYTHONPATH=that/checkout) to see the same cases before.
+
+  1. half_power on a ring-down, noise-free, zeta 0.05-0.3 at 9 phases: worst |fn| and |zeta| error.
+  2. half_power on a ring-down with an offset and a drift of 0.1 units/s (zeta 0.05, 40 dB).
+  3. half_power's std against its scatter (zeta 0.02, 40 dB, 60 seeds).
+  4. log_decrement on two modes (10 and 25 Hz, amplitude ratio 0.5): zeta error and flag; and on
+     single-mode decays (zeta 0.001-0.1, 20-60 dB, 5 seeds): how many are flagged.
+  5. half_power of an FRF holding NaN lines outside its band (a swept sine without power there).
+  6. oma_fdd without band=; the OMA duration rule on a 10 s record with a 8.9 Hz mode.
+  7. vm.read of whitespace-separated columns (.asc).
+
+    python benchmarks/edges.py            (about 30 s)
+"""
+
+import dataclasses
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import vibmeasure as vm
+
+
+def case(name, fn):
+    try:
+        print(f"{name}: {fn()}")
+    except Exception as exc:  # noqa: BLE001 - an edge case's outcome is what we print
+        print(f"{name}: {type(exc).__name__}: {str(exc)[:150]}")
+
+
+def half_power_bias():
+    out = []
+    for z in (0.05, 0.1, 0.2, 0.3):
+        worst_f = worst_z = 0.0
+        for ph in np.linspace(0, np.pi, 9):
+            rec = vm.synth.free_decay(fn=10.0, zeta=z, fs=1000.0, duration=20.0, phase=ph)
+            try:
+                e = vm.half_power(rec)
+            except vm.FitError as exc:
+                out.append(f"zeta {z}: refused ({str(exc)[:60]})")
+                break
+            worst_f, worst_z = max(worst_f, abs(e.fn[0] / 10 - 1)), max(worst_z, abs(e.zeta[0] / z - 1))
+        else:
+            out.append(f"zeta {z}: fn {100 * worst_f:.3f} %, zeta {100 * worst_z:.3f} %")
+    return "; ".join(out)
+
+
+def half_power_drift():
+    rec = vm.synth.free_decay(fn=10.0, zeta=0.05, fs=1000.0, duration=10.0, snr_db=40, seed=1, dc_offset=0.1,
+                              drift=0.1)
+    e = vm.half_power(rec)
+    return f"zeta {e.zeta[0]:.5f} (true 0.05) +- {e.zeta_std[0]:.2g}"
+
+
+def half_power_std():
+    errs, stds = [], []
+    for seed in range(60):
+        e = vm.half_power(vm.synth.free_decay(fn=10.0, zeta=0.02, fs=1000.0, duration=20.0, snr_db=40, seed=seed))
+        errs.append(e.zeta[0] - 0.02)
+        stds.append(e.zeta_std[0])
+    if not np.isfinite(np.mean(stds)):
+        return "no std (NaN)"
+    return f"RMS error / mean std = {np.sqrt(np.mean(np.square(errs))) / np.mean(stds):.2f}"
+
+
+def log_decrement_modes():
+    two = vm.synth.free_decay(fn=[10.0, 25.0], zeta=[0.02, 0.02], amplitude=[1.0, 0.5], fs=1000.0, duration=10.0,
+                              snr_db=40, seed=3)
+    e = vm.log_decrement(two)
+    flagged = tot = 0
+    for z in (0.001, 0.005, 0.02, 0.1):
+        for snr in (20, 40, 60):
+            for seed in range(5):
+                try:
+                    s = vm.log_decrement(vm.synth.free_decay(fn=10.0, zeta=z, fs=1000.0, duration=10.0, snr_db=snr,
+                                                             seed=seed))
+                except vm.FitError:
+                    continue
+                tot += 1
+                flagged += "several_modes" in s.flags
+    return (f"two modes: zeta {100 * (e.zeta[0] / 0.02 - 1):+.1f} %, flags {list(e.flags)}; single modes flagged "
+            f"several_modes: {flagged} of {tot}")
+
+
+def half_power_nan_outside_band():
+    h = vm.synth.modal_frf(np.linspace(1, 100, 4000), fn=[30.0], zeta=[0.02], shapes=[[1.0]], form="mobility")
+    holed = h.h.copy()
+    holed[..., :200] = np.nan
+    return f"zeta {vm.half_power(dataclasses.replace(h, h=holed), band=(20, 40)).zeta[0]:.5f} (true 0.02)"
+
+
+def oma_defaults():
+    m = vm.models.MDOF(np.eye(3), np.array([[2e4, -1e4, 0], [-1e4, 2e4, -1e4], [0, -1e4, 1e4]]), modal_zeta=[0.02] * 3)
+    amb = vm.synth.ambient(m, fs=100.0, duration=300.0, noise=0.05, seed=1)
+    fdd = vm.oma_fdd(amb)
+    return f"oma_fdd without band: {np.round(fdd.fn, 2).tolist()} Hz (true {np.round(m.modes().fn, 2).tolist()})"
+
+
+def oma_duration():
+    m = vm.models.MDOF(np.eye(3), np.array([[2e4, -1e4, 0], [-1e4, 2e4, -1e4], [0, -1e4, 1e4]]), modal_zeta=[0.02] * 3)
+    amb = vm.synth.ambient(m, fs=100.0, duration=12.0, noise=0.05, seed=1)
+    e = vm.oma_ssi(amb, band=(1, 40), n_blocks=5)
+    return "; ".join(f"{f:.2f} Hz {list(fl)}" for f, fl in zip(e.fn, e.mode_flags))
+
+
+def read_whitespace():
+    p = Path(tempfile.mkdtemp()) / "log.asc"
+    p.write_text("acc1 acc2\n 0.125  -1.5e-3\n 0.250   2.0e-3\n-0.375   1.0e-3\n")
+    r = vm.read(p, fs=100.0)
+    return f"{r.names} {r.data.tolist()}"
+
+
+def main():
+    warnings.simplefilter("ignore")
+    case("1. half_power on ring-downs (noise-free, worst over 9 phases)", half_power_bias)
+    case("2. half_power with offset and drift", half_power_drift)
+    case("3. half_power std", half_power_std)
+    case("4. log_decrement, several modes", log_decrement_modes)
+    case("5. half_power of an FRF with NaN lines outside the band", half_power_nan_outside_band)
+    case("6a. oma_fdd defaults", oma_defaults)
+    case("6b. OMA duration rule (12 s record, 3-DOF chain, band 1-40 Hz)", oma_duration)
+    case("7. vm.read of whitespace-separated columns", read_whitespace)
+
+
+if __name__ == "__main__":
+    main()
