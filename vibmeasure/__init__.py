@@ -19,7 +19,7 @@ __version__ = "0.1.0"
 
 # public name -> (module, attribute): imported when first used (PEP 562)
 _LAZY = {
-    "half_power": (".identify.damping", "half_power"),
+    "half_power": (".identify.halfpower", "half_power"),
     "hilbert_decay": (".identify.damping", "hilbert_decay"),
     "log_decrement": (".identify.damping", "log_decrement"),
     "zeta_from_delta": (".identify.damping", "zeta_from_delta"),

@@ -74,7 +74,8 @@ def _ringdown(args, out, err=None):
     elif args.method == "hilbert":
         est = damping.hilbert_decay(rec, channel=args.channel, band=band)
     else:
-        est = damping.half_power(rec, channel=args.channel, band=band)
+        from ..identify.halfpower import half_power
+        est = half_power(rec, channel=args.channel, band=band)
     if args.plot:
         _save_plot(args.plot, rec, est)
     return rec, est

@@ -6,6 +6,7 @@ import numpy as np
 from scipy import signal as _sig
 from scipy.ndimage import uniform_filter1d
 
+from ..core.errors import FitError
 from ..core.record import Record
 
 CLIP_RUN = 3  # consecutive samples at the extreme that count as clipping
@@ -375,3 +376,64 @@ def decimation_factor(x: np.ndarray, fs: float, band=None) -> tuple[int, float]:
     if f_top <= 0:
         return 1, 0.0
     return max(1, int(fs / (DECIMATE_FS_OVER_F * f_top))), f_top
+
+
+def _hp_nfft(n: int) -> int:
+    """FFT length for the half-power spectrum: 16x padding, within 2^25 lines (768 MiB of spectrum)
+    for long records."""
+    return int(2 ** np.ceil(np.log2(min(16 * n, max(1 << 25, n)))))
+
+def _halfpower_points(x, fs, band, *, details: bool = False):
+    """Interpolated half-power frequencies of the strongest peak of a decay's spectrum (16x padded);
+    with ``details`` (the noise's mean power taken off every line first) also the phase of the decay
+    at its start (from the complex peak) and the standard deviations of f1 + f2 and of f2 - f1 from
+    the noise in the lines."""
+    n = x.size
+    y = x - np.median(x[-max(8, n // 20):])
+    nfft = _hp_nfft(n)
+    X = np.fft.rfft(y, nfft)
+    # white noise of std s puts n s^2 into every line's |X|^2 on average (padding adds none): taken off,
+    # so the floor does not lift the half-power level
+    var_line = n * noise_std(y, fs) ** 2 if details else 0.0
+    P = np.maximum(np.abs(X) ** 2 - var_line, 0.0)
+    f = np.fft.rfftfreq(nfft, 1 / fs)
+    sel = np.ones_like(f, bool) if band is None else (f >= band[0]) & (f <= band[1])
+    sel[0] = False
+    idx = np.flatnonzero(sel)
+    k = idx[int(np.argmax(P[sel]))]
+    if band is not None and k in (idx[0], idx[-1]):
+        raise FitError(f"half_power: the strongest line in band={band} sits on its edge ({f[k]:.4g} Hz): no peak "
+                       "inside the band")
+    f1, f2, lo, hi = half_power_crossings(f, P, k, lower_msg="a half-power point lies outside the spectrum "
+                                          "(damping too high or the peak at the band edge)")
+    if not details:
+        return f1, f2
+    sigma, wd = np.pi * (f2 - f1), np.pi * (f1 + f2)
+    phase = float(np.angle(X[k]) + np.arctan2(2 * np.pi * f[k] - wd, sigma))
+    # at a crossing P = |S + N|^2 moves by about sqrt(2 P n s^2), and the half level with the peak's
+    # own noise: both crossings move apart or together by that over their slopes dP/df
+    slopes = [abs(P[j + 1] - P[j]) / (f[j + 1] - f[j]) for j in (lo, hi - 1)]
+    if min(slopes) <= 0:
+        return f1, f2, phase, (np.inf, np.inf)
+    sd_cross = [float(np.sqrt(2 * P[k] / 2 * var_line)) / sl for sl in slopes]
+    sd_level = float(np.sqrt(2 * P[k] * var_line)) / 2 * (1 / slopes[0] + 1 / slopes[1])
+    stds = (float(np.hypot(sd_cross[0], sd_cross[1])), float(np.hypot(np.hypot(*sd_cross), sd_level)))
+    return f1, f2, phase, stds
+
+def half_power_crossings(freq, P, k, *, lower_msg: str):
+    """Frequencies where the power P falls to half its value at line k on either side, linearly
+    interpolated between lines; FitError when a crossing lies outside the data."""
+    half = P[k] / 2
+    lo = k
+    while lo > 0 and P[lo] > half:
+        lo -= 1
+    hi = k
+    while hi < P.size - 1 and P[hi] > half:
+        hi += 1
+    if P[lo] > half or freq[lo] <= 0:
+        raise FitError(f"half_power: {lower_msg}")
+    if P[hi] > half:
+        raise FitError("half_power: the upper half-power point lies beyond the data")
+    f1 = freq[lo] + (half - P[lo]) * (freq[lo + 1] - freq[lo]) / (P[lo + 1] - P[lo])
+    f2 = freq[hi - 1] + (half - P[hi - 1]) * (freq[hi] - freq[hi - 1]) / (P[hi] - P[hi - 1])
+    return float(f1), float(f2), lo, hi
