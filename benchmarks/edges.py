@@ -9,6 +9,8 @@ vibmeasure gives. Run it on an older checkout (PYTHONPATH=that/checkout) to see 
   5. half_power of an FRF holding NaN lines outside its band (a swept sine without power there).
   6. oma_fdd without band=; the OMA duration rule on a 10 s record with a 8.9 Hz mode.
   7. vm.read of whitespace-separated columns (.asc).
+  8. The README's Coulomb decay (friction 4e-4 per cycle) through ringdown and the classic estimators.
+  9. vm.srs of a record that starts at 1 (fs 1 kHz) against scipy's lsim, oscillators below and above fs/32.
 
     python benchmarks/edges.py            (about 30 s)
 """
@@ -112,6 +114,34 @@ def read_whitespace():
     return f"{r.names} {r.data.tolist()}"
 
 
+def coulomb():
+    rec = vm.synth.coulomb_decay(fn=4.2, friction_decay=4e-4, amplitude=5e-3, fs=500, duration=6)
+    out = []
+    for method in (vm.ringdown, vm.log_decrement, vm.half_power, vm.hilbert_decay):
+        e = method(rec)
+        fric = e.extras.get("friction_decay_per_cycle")
+        out.append(f"{method.__name__}: zeta {e.zeta[0]:.4g}, coulomb_friction {'coulomb_friction' in e.flags}"
+                   + (f" ({fric:.3g}/cycle)" if fric is not None else ""))
+    return "; ".join(out)
+
+
+def srs_first_sample():
+    from scipy import signal as sg
+    fs, n = 1000.0, 2000
+    x = np.ones(n)
+    x[1000:] = 0.5
+    fn = np.array([20.0, 40.0, 100.0, 200.0])
+    sp = vm.srs(vm.Record.from_array(x, fs=fs, unit="m/s^2"), fn=fn, zeta=0.05)
+    t0, u0 = np.arange(-1, n) / fs, np.concatenate([[0.0], x])
+    out = []
+    for f, v in zip(fn, sp.values["maximax"]):
+        w = 2 * np.pi * f
+        tt = np.linspace(t0[0], t0[-1] + 1.0, 600001)
+        _, yy, _ = sg.lsim(sg.lti([0.1 * w, w ** 2], [1, 0.1 * w, w ** 2]), np.interp(tt, t0, u0, right=0.0), tt - tt[0])
+        out.append(f"{f:g} Hz {100 * (v / np.abs(yy).max() - 1):+.4f} %")
+    return ", ".join(out)
+
+
 def main():
     warnings.simplefilter("ignore")
     case("1. half_power on ring-downs (noise-free, worst over 9 phases)", half_power_bias)
@@ -122,6 +152,8 @@ def main():
     case("6a. oma_fdd defaults", oma_defaults)
     case("6b. OMA duration rule (12 s record, 3-DOF chain, band 1-40 Hz)", oma_duration)
     case("7. vm.read of whitespace-separated columns", read_whitespace)
+    case("8. a Coulomb decay", coulomb)
+    case("9. srs of a record starting at 1, against lsim", srs_first_sample)
 
 
 if __name__ == "__main__":

@@ -29,6 +29,16 @@ def _nonlinear_damping(x, fs, fd, noise, t_end):
     return out
 
 
+def coulomb_signature(x, fs, fd, noise) -> dict | None:
+    """The dry-friction test every decay estimator runs (``_coulomb_envelope`` on the leading regular
+    cycles): {"decay_per_cycle", "decay_per_cycle_std", ...} when the envelope falls linearly and the
+    motion stops, else None."""
+    tp, ap, cut = _regular_cycles(x, fs, fd, noise)
+    if tp.size < 8:
+        return None
+    return _coulomb_envelope(x, fs, fd, noise, tp, ap, cut)
+
+
 def _regular_cycles(x, fs, fd, noise):
     """Cycle peaks above 10 x the noise, only the leading run of regular half cycles: where another
     component (a leaked neighbour, noise) takes over, the spacing of the extremes goes astray."""
@@ -56,8 +66,9 @@ def _coulomb_envelope(x, fs, fd, noise, tp, ap, cut):
     rss_lin, rss_exp = float(r_lin @ r_lin), float(r_exp @ r_exp)
     t_zero = -lin[1] / lin[0] if lin[0] < 0 else np.inf
     after = x[int(min(x.size, np.ceil((t_zero + 1.5 / fd) * fs))):]
+    # stuck: the rest stays within the noise (a noise-free record's noise estimate is 0: within round-off)
     stuck = (not cut and tp[-1] <= t_zero <= tp[-1] + 3 / fd and after.size >= fs / fd
-             and np.std(after) < 3 * noise)
+             and np.std(after) <= 3 * noise + 1e-9 * float(np.max(np.abs(x))))
     if not (stuck and rss_lin < 0.2 * rss_exp):
         return None
     slope_std = np.sqrt(rss_lin / max(tp.size - 2, 1) / np.sum((tp - tp.mean()) ** 2))

@@ -13,6 +13,7 @@ from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import ModalEstimate
 from ._decay import (_halfpower_points, baseline_line, clipped_mask, cycle_peaks, decay_start, detrend_linear,
                      noise_std, spectral_peak, trim_to_decay)
+from ._rd_checks import coulomb_signature
 
 __all__ = ["log_decrement", "hilbert_decay", "zeta_from_delta"]
 
@@ -177,9 +178,26 @@ def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: 
     others = _other_modes(x, fsr, fd0, zeta, band)
     if others:
         flags.append("several_modes")
-    return _finish(rec, idx, "logdec", fn, zeta, fn_std, zeta_std, flags,
-                   {"delta": float(delta), "delta_std": float(delta_std), "n_cycles": int(m), "cycles_apart": n,
-                    "noise_std": noise, "start_s": i0 / fsr + rec.t0, "other_modes_hz": others})
+    extras = {"delta": float(delta), "delta_std": float(delta_std), "n_cycles": int(m), "cycles_apart": n,
+              "noise_std": noise, "start_s": i0 / fsr + rec.t0, "other_modes_hz": others}
+    extras.update(coulomb_extras(rec, idx, i0, x if band is not None else None, fd0, noise, flags))
+    return _finish(rec, idx, "logdec", fn, zeta, fn_std, zeta_std, flags, extras)
+
+
+def coulomb_extras(rec, idx, i0, x, fd, noise, flags) -> dict:
+    """A dry-friction decay (its envelope falls linearly and stops) has no viscous zeta: the flag
+    ``coulomb_friction`` and the friction decay per cycle, for every classic estimator. The test needs
+    the motion after it stopped: the channel from the decay's start, not trimmed to the decay (``x``,
+    the band-passed decay, when the estimator band-passes)."""
+    if x is None:
+        raw = np.asarray(rec.data[idx, i0:], float)
+        x = raw - np.median(raw)   # a line through the extremes would tilt the stuck tail
+    sig = coulomb_signature(x, rec.fs, fd, noise)
+    if sig is None:
+        return {}
+    flags.append("coulomb_friction")
+    return {"friction_decay_per_cycle": sig["decay_per_cycle"],
+            "friction_decay_per_cycle_std": sig["decay_per_cycle_std"]}
 
 
 # Another decaying mode whose spectral peak stands at least OTHER_MODE_RATIO of the analysed mode's (and
@@ -316,9 +334,10 @@ def hilbert_decay(rec, *, channel=None, band=None, start: float | None = None,
     wn, zeta, fn_std, zeta_std = _envelope_fit(t[ok], env[ok], ph[ok], fsr, band[1] - band[0])
     if fsr * (t[ok][-1] - t[ok][0]) * fd0 / fsr < 5:
         flags.append("few_cycles")
-    return _finish(rec, idx, "hilbert", wn / (2 * np.pi), zeta, fn_std, zeta_std, flags,
-                   {"band_hz": list(band), "fit_from_s": float(t[ok][0]), "fit_to_s": float(t[ok][-1]),
-                    "start_s": i0 / fsr + rec.t0})
+    extras = {"band_hz": list(band), "fit_from_s": float(t[ok][0]), "fit_to_s": float(t[ok][-1]),
+              "start_s": i0 / fsr + rec.t0}
+    extras.update(coulomb_extras(rec, idx, i0, x, fd0, noise_std(x, fsr), flags))
+    return _finish(rec, idx, "hilbert", wn / (2 * np.pi), zeta, fn_std, zeta_std, flags, extras)
 
 
 def _hilbert_band(x, fs, fd0, b0):

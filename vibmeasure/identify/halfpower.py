@@ -8,8 +8,8 @@ import numpy as np
 from ..core._validate import check_band, memory_guard, name_index
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import FRF, ModalEstimate, Spectrum
-from ._decay import _halfpower_points, _hp_nfft, baseline_line, half_power_crossings, spectral_peak
-from .damping import _finish, _prepare
+from ._decay import _halfpower_points, _hp_nfft, baseline_line, half_power_crossings, noise_std, spectral_peak
+from .damping import _finish, _prepare, coulomb_extras
 
 __all__ = ["half_power", "half_power_frf"]
 
@@ -90,11 +90,13 @@ def half_power(obj, *, band=None, channel=None, start: float | None = None, fs: 
     wn = 2 * np.pi * fn
     fn_std = float(sd_fd)
     zeta_std = float(sd_sigma / wn)
-    return _finish(rec, idx, "halfpower", fn, zeta, fn_std, zeta_std, flags,
-                   {"f1_hz": float(f1), "f2_hz": float(f2), "sigma_T": float(sigma * T),
-                    "bias_removed_fn_hz": bias[0], "bias_removed_zeta": bias[1], "phase_rad": phase,
-                    "std": "first order, from the noise in the lines at the half-power crossings",
-                    "start_s": i0 / fsr + rec.t0})
+    extras = {"f1_hz": float(f1), "f2_hz": float(f2), "sigma_T": float(sigma * T),
+              "bias_removed_fn_hz": bias[0], "bias_removed_zeta": bias[1], "phase_rad": phase,
+              "std": "first order, from the noise in the lines at the half-power crossings",
+              "start_s": i0 / fsr + rec.t0}
+    extras.update(coulomb_extras(rec, idx, i0, None, fn * np.sqrt(max(1 - zeta ** 2, 0.0)), noise_std(x, fsr), flags))
+    return _finish(rec, idx, "halfpower", fn, zeta, fn_std, zeta_std, flags, extras)
+
 
 def _hp_baseline_removed(x, fs, band):
     """The decay without its offset and drift, which would otherwise stand as the strongest

@@ -148,14 +148,20 @@ def _response(x, fs, f, zeta, output, tail, k_end):
     to at least PTS_PER_CYCLE samples per cycle."""
     from scipy.signal import lfilter
     m = max(1, int(np.ceil(PTS_PER_CYCLE * f / fs)))
+    lead = 0
     if m > 1:
-        t = np.arange(x.size)
-        x = np.interp(np.arange((x.size - 1) * m + 1) / m, t, x)
+        # the recursive filter takes the input as 0 one step before the record, so on the record's own
+        # grid the first sample is reached by a ramp of one sample (1/fs); the finer copy keeps that
+        # ramp (from 0 at -1/fs), or a record that starts away from 0 would jump in 1/(m fs)
+        t = np.arange(-1, x.size)
+        x = np.interp(np.arange(-m, (x.size - 1) * m + 1) / m, t, np.concatenate([[0.0], x]))
+        lead = m - 1   # the fine samples before t = 0 (the one at -1/fs is the filter's own zero)
+        x = x[1:]
     fs_m = fs * m
     b, a = srs_coefficients([f], zeta, fs_m, output)
     n_tail = int(np.ceil(tail * fs_m)) + 2
     xx = np.concatenate([x, np.zeros(n_tail)])
-    y = lfilter(b[0], a[0], xx)
+    y = lfilter(b[0], a[0], xx)[lead:]
     return y[: k_end * m + 1], y[k_end * m + 1:]
 
 
