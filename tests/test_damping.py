@@ -184,9 +184,9 @@ def test_log_decrement_flags_several_modes_in_its_band():
         vm.log_decrement(two)
 
 
-@pytest.mark.parametrize("snr", [None, 40])
+@pytest.mark.parametrize("snr", [None, 40, 30])
 def test_every_decay_estimator_recognises_dry_friction(snr):
-    """The README's Coulomb example (friction_decay 4e-4 per cycle from 5e-3, noise-free and at 40 dB):
+    """The README's Coulomb example (friction_decay 4e-4 per cycle from 5e-3, noise-free, 40 and 30 dB):
     ring-down, log decrement, half-power and Hilbert each flag coulomb_friction and give the friction
     decay per cycle (within 1 %: the cycle amplitudes fall on a line); a viscous decay with an offset and
     a drift is never flagged."""

@@ -67,7 +67,9 @@ def _coulomb_envelope(x, fs, fd, noise, tp, ap, cut):
     t_zero = -lin[1] / lin[0] if lin[0] < 0 else np.inf
     after = x[int(min(x.size, np.ceil((t_zero + 1.5 / fd) * fs))):]
     # stuck: the rest stays within the noise (a noise-free record's noise estimate is 0: within round-off)
-    stuck = (not cut and tp[-1] <= t_zero <= tp[-1] + 3 / fd and after.size >= fs / fd
+    # the line reaches zero after the last cycle used (those stop at 10 x the noise, so at 30 dB the
+    # last lies a few cycles before the stop); what follows stays put
+    stuck = (not cut and tp[-1] <= t_zero and after.size >= fs / fd
              and np.std(after) <= 3 * noise + 1e-9 * float(np.max(np.abs(x))))
     if not (stuck and rss_lin < 0.2 * rss_exp):
         return None
