@@ -19,6 +19,8 @@ def test_a_record_is_analysed_by_what_it_holds():
     assert analysis_for(machine) == "diagnose"
     assert analysis_for(hammer) == "modes"                               # a force channel wins
     assert analysis_for(hammer, rpm=1500.0) == "modes"
+    with pytest.raises(vm.ParameterError, match="rec must be a vm.Record"):
+        analysis_for("pump.h5")
 
 
 def test_batch_auto_runs_each_file_by_its_content(tmp_path):

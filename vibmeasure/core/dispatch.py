@@ -29,6 +29,11 @@ def analysis_for(rec, *, rpm=None, tach=None) -> str:
     str
         "modes", "diagnose" or "ringdown".
 
+    Raises
+    ------
+    ParameterError
+        When ``rec`` is not a record (read a file with ``vm.read`` first).
+
     Examples
     --------
     >>> import vibmeasure as vm
@@ -38,6 +43,10 @@ def analysis_for(rec, *, rpm=None, tach=None) -> str:
     >>> analysis_for(vm.synth.machine(rpm=1797, duration=1.0))
     'diagnose'
     """
+    from .errors import ParameterError
+    from .record import Record
+    if not isinstance(rec, Record) and not hasattr(rec, "channels"):   # a Record or a LazyRecord
+        raise ParameterError(f"rec must be a vm.Record (read the file with vm.read first), got {type(rec).__name__}")
     if any(c.quantity == "force" for c in rec.channels):
         return "modes"
     if rpm or tach is not None or rec.meta.get("rpm"):
