@@ -142,6 +142,25 @@ def srs_first_sample():
     return ", ".join(out)
 
 
+def srs_residual_high_damping():
+    from scipy import signal as sg
+    fs, tau = 20_000.0, 2e-3
+    t = np.arange(41) / fs
+    x = np.where(t < tau, 50.0 * np.sin(np.pi * t / tau), 0.0)
+    t0, u0 = np.arange(-1, x.size) / fs, np.concatenate([[0.0], x])
+    out = []
+    for z in (0.7, 0.9):
+        sp = vm.srs(vm.Record.from_array(x, fs=fs, unit="m/s^2"), fn=[200.0, 1000.0], zeta=z)
+        for k, f in enumerate((200.0, 1000.0)):
+            w = 2 * np.pi * f
+            tt = np.linspace(t0[0], t0[-1] + 20.0 / f, 400001)
+            _, yy, _ = sg.lsim(sg.lti([2 * z * w, w ** 2], [1, 2 * z * w, w ** 2]), np.interp(tt, t0, u0, right=0.0),
+                               tt - tt[0])
+            exact = max(yy[tt >= t0[-1]].max(), 0.0)
+            out.append(f"zeta {z} {f:g} Hz {sp.extras['residual_positive'][k]:.3f} / {exact:.3f}")
+    return ", ".join(out)
+
+
 def main():
     warnings.simplefilter("ignore")
     case("1. half_power on ring-downs (noise-free, worst over 9 phases)", half_power_bias)
@@ -154,6 +173,7 @@ def main():
     case("7. vm.read of whitespace-separated columns", read_whitespace)
     case("8. a Coulomb decay", coulomb)
     case("9. srs of a record starting at 1, against lsim", srs_first_sample)
+    case("10. srs positive residual of a half-sine at high damping (vibmeasure / lsim)", srs_residual_high_damping)
 
 
 if __name__ == "__main__":

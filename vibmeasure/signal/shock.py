@@ -162,7 +162,9 @@ def _response(x, fs, f, zeta, output, tail, k_end):
     n_tail = int(np.ceil(tail * fs_m)) + 2
     xx = np.concatenate([x, np.zeros(n_tail)])
     y = lfilter(b[0], a[0], xx)[lead:]
-    return y[: k_end * m + 1], y[k_end * m + 1:]
+    # the residual is the response from the pulse's end on, that instant included: a heavily damped
+    # response that decays from it has its residual peak there
+    return y[: k_end * m + 1], y[k_end * m:]
 
 
 def srs(rec, *, fn=None, zeta: float | None = None, Q: float | None = None, kind: str = "maximax",
@@ -233,8 +235,9 @@ def srs(rec, *, fn=None, zeta: float | None = None, Q: float | None = None, kind
         raise ParameterError(f"pulse_end={pulse_end} s is after the record's end ({(x.size - 1) / rec.fs:g} s)")
     prim, resid = np.zeros((2, f.size)), np.zeros((2, f.size))
     for k, fk in enumerate(f):
-        # the residual's largest peak comes within the first cycle of the free vibration
-        y_p, y_r = _response(x, rec.fs, fk, z, filt, 1.0 / fk, k_end)
+        # the free vibration's positive and negative extrema follow each other half a damped period
+        # apart, so both are within its first damped period (1/fd, fd = fn sqrt(1 - zeta^2)), plus margin
+        y_p, y_r = _response(x, rec.fs, fk, z, filt, 1.25 / (fk * np.sqrt(1.0 - z * z)), k_end)
         (pp,), (pn,) = _peaks(y_p[None])
         (rp,), (rn,) = _peaks(y_r[None])
         prim[:, k] = pp, pn
