@@ -29,6 +29,7 @@ _LAZY = {
     "circle_fit": (".identify.modal", "circle_fit"),
     "oma_ssi": (".identify.oma", "oma_ssi"),
     "oma_fdd": (".identify.oma", "oma_fdd"),
+    "oma_cross_check": (".identify.oma", "oma_cross_check"),
     "fit_modes": (".identify.modal", "fit_modes"),
     "mac": (".identify.shapes", "mac"),
     "modal_crb": (".identify.modal", "modal_crb"),
@@ -111,7 +112,7 @@ __all__ = [
     "prewhiten", "remove_synchronous", "kurtogram", "band_ses", "despike",
     "detrend", "filter", "decimate", "resample", "integrate", "differentiate",
     "ringdown", "ringdown_crb", "estimate_frf", "impact_frf", "find_hits", "fit_modes", "circle_fit", "mac",
-    "modal_crb", "synthesize_frf", "oma_ssi", "oma_fdd", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
+    "modal_crb", "synthesize_frf", "oma_ssi", "oma_fdd", "oma_cross_check", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
     "compare", "Comparison", "History", "diagnose", "Diagnosis", "severity_zone", "Bearing", "Gear", "BEARINGS",
     "Store", "StoreLockedError", "batch", "read_manifest", "trend", "report", "models", "synth", "units", "__version__",
 ]

@@ -11,9 +11,10 @@ def register(sub) -> None:
                         description="Natural frequencies, damping (with std) and shapes from responses to ambient "
                                     "or operating excitation: covariance-driven SSI (default) or FDD/EFDD.")
     om.add_argument("file", help="record of the responses: .csv .h5 .wav .mat .lvm .uff")
-    om.add_argument("--method", choices=("ssi", "fdd"), default="ssi",
+    om.add_argument("--method", choices=("ssi", "fdd", "both"), default="ssi",
                     help="ssi: covariance-driven stochastic subspace identification (default); fdd: frequency-"
-                         "domain decomposition with EFDD damping")
+                         "domain decomposition with EFDD damping; both: SSI's modes, each checked against FDD "
+                         "(flags methods_disagree, not_confirmed)")
     om.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"),
                     help="frequency band (Hz); default the whole range")
     om.add_argument("--channel", action="append", help="output channel(s) (default: all that are not forces)")
@@ -30,20 +31,21 @@ def run(args, out, err) -> int:
     """The modes (with stds and MPC) and the poles refused: printed (or one JSON document), and the
     stabilisation diagram or singular values as a picture."""
     from .. import io
-    from ..identify.oma import oma_fdd, oma_ssi
+    from ..identify.oma import oma_cross_check, oma_fdd, oma_ssi
     rec = io.read(args.file, fs=args.fs, channels=args.channel)
     band = tuple(args.band) if args.band else None
     with quality_warnings() as msgs:
-        if args.method == "ssi":
+        if args.method in ("ssi", "both"):
             est = oma_ssi(rec, band=band, max_order=args.max_order, block_rows=args.block_rows)
-        else:
-            est = oma_fdd(rec, band=band, nperseg=args.nperseg)
+        if args.method in ("fdd", "both"):
+            fdd = oma_fdd(rec, band=band, nperseg=args.nperseg)
+            est = fdd if args.method == "fdd" else oma_cross_check(est, fdd)
     rejected = est.extras.get("rejected_modes", [])
     if args.json:
         from ..core.results import jsonable
         doc = {"command": "oma", "file": str(args.file), "fs_hz": rec.fs, **est.to_dict(), "warnings": msgs}
-        doc["extras"] = {k: jsonable(est.extras[k]) for k in ("band_hz", "outputs", "mpc", "std_method")
-                         if k in est.extras}
+        doc["extras"] = {k: jsonable(est.extras[k]) for k in ("band_hz", "outputs", "mpc", "std_method", "cross_check",
+                                                              "unresolved_close_modes_hz") if k in est.extras}
         doc["shapes"] = [[[float(v.real), float(v.imag)] for v in col] for col in est.shapes.T]
         doc["rejected"] = jsonable(rejected)
         emit_json(doc, out)
@@ -60,7 +62,7 @@ def run(args, out, err) -> int:
     print_warnings(msgs, err)
     if args.plot:
         pm = plot_module()
-        ax = pm.plot_stabilisation(est) if args.method == "ssi" else pm.plot_singular_values(est)
+        ax = pm.plot_singular_values(est) if args.method == "fdd" else pm.plot_stabilisation(est)
         save_figure(ax.figure, args.plot)
         print(f"vibmeasure: wrote {args.plot}", file=err)
     return 0

@@ -16,6 +16,11 @@ FLAG_TEXT = {
     "resolution_limited": "sampling or frequency resolution too coarse for a sound estimate",
     "clipped": "clipped samples (3 or more in a row at the extreme) were excluded",
     "close_modes": "another mode lies within a few half-power bandwidths: estimates interact",
+    "unresolved_close_modes": "a resonance holds two or more modes closer than the frequency resolution separates; "
+                              "they are left out: see extras['unresolved_close_modes_hz']",
+    "methods_disagree": "two identification methods run on the same data give this mode's fn or zeta further apart "
+                        "than three of their combined stds: at least one is biased",
+    "not_confirmed": "the other identification method run on the same data does not find this mode",
     "several_modes": "the analysed band holds more than one decaying mode: the decrement mixes them",
     "overdamped": "no oscillation: the system is critically or over damped (zeta >= 1); no frequency",
     "coulomb_friction": "the envelope decays linearly, as with dry (Coulomb) friction: viscous zeta does "

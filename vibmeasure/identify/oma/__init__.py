@@ -10,11 +10,12 @@ standard deviations come from a block jackknife of the covariance estimate.
 ``oma_fdd`` (fdd.py): frequency-domain decomposition. The SVD of the output cross-spectral matrix at
 every line separates the modes: near a mode the first singular value is that mode's SDOF bell and its
 singular vector the shape. EFDD takes each bell back to a free decay and fits it with the ring-down
-estimator. ``_common.py`` holds what both share: output checks, duration rule, band kurtosis.
+estimator. ``oma_cross_check`` (crosscheck.py) flags the modes the two place apart. ``_common.py`` holds what both share: output checks, duration rule, band kurtosis.
 """
 
 from ..shapes import mpc, mpd
+from .crosscheck import oma_cross_check
 from .fdd import oma_fdd
 from .ssi import oma_ssi
 
-__all__ = ["oma_ssi", "oma_fdd", "mpc", "mpd"]
+__all__ = ["oma_ssi", "oma_fdd", "oma_cross_check", "mpc", "mpd"]

@@ -16,7 +16,8 @@ from ...core.record import Record
 from ...core.results import ModalEstimate
 from ..limits import MAX_REL_ZETA_STD
 from ..shapes import mac_pair, mpc
-from ._common import MIN_CYCLES, N_GROUPS, TONE_KURTOSIS, _check_duration, _normalise, _outputs, band_kurtosis
+from ._common import (MIN_CYCLES, N_GROUPS, _check_duration, _normalise, _outputs, band_kurtosis,
+                      harmonic_by_kurtosis)
 
 __all__ = ["oma_fdd"]
 
@@ -32,7 +33,10 @@ def _csd_matrix(Y, fs, nperseg):
     starts = range(0, n - nperseg + 1, step)
     nf = nperseg + 1
     n_seg = len(starts)
-    n_g = N_GROUPS if n_seg >= 2 * N_GROUPS and nf * l * l * 16 * N_GROUPS < 5e8 else 0
+    # the jackknife needs at least 3 groups of 2 segments: fewer segments (a long nperseg) get fewer groups,
+    # never a std from the white-error fit alone (which let noise peaks of a 4-segment average pass)
+    n_g = min(N_GROUPS, n_seg // 2)
+    n_g = n_g if n_g >= 3 and nf * l * l * 16 * n_g < 5e8 else 0
     Gg = np.zeros((max(n_g, 1), nf, l, l), complex)
     for j, k0 in enumerate(starts):
         X = np.fft.rfft(Y[:, k0:k0 + nperseg] * w, n=2 * nperseg, axis=1)  # (l, nf)
@@ -48,9 +52,10 @@ def _fdd_nperseg(nperseg, n):
     if nperseg is None:
         nper = 2 ** int(np.log2(max(n // 8, 16)))
         return int(min(nper, 2 ** 16))
-    if isinstance(nperseg, bool) or not isinstance(nperseg, (int, np.integer)) or not 16 <= nperseg <= n // 2:
-        raise ParameterError(f"nperseg={nperseg!r} must be an integer from 16 to half the record ({n // 2}): "
-                             "the decomposition averages at least 3 segments")
+    if isinstance(nperseg, bool) or not isinstance(nperseg, (int, np.integer)) or not 16 <= nperseg <= n // 4:
+        raise ParameterError(f"nperseg={nperseg!r} must be an integer from 16 to a quarter of the record ({n // 4}): "
+                             "the decomposition averages at least 7 segments, in at least 3 groups for the "
+                             "jackknife std (fewer leave the singular values too noisy to tell a mode from noise)")
     return int(nperseg)
 
 
@@ -62,6 +67,7 @@ def _fdd_peaks(f, S, U, sel, min_prom_db, df_seg, n_modes, Y, fs):
     from scipy.signal import find_peaks
     idx = np.flatnonzero(sel)
     picked, rejected = [], []
+    floor = float(np.median(S[idx, -1])) if S.shape[1] > 1 else 0.0   # the noise: the last singular value
     for j in range(min(2, S.shape[1])):
         s_db = 10 * np.log10(np.maximum(S[idx, j], 1e-300))
         pk, props = find_peaks(s_db, prominence=min_prom_db)
@@ -75,11 +81,19 @@ def _fdd_peaks(f, S, U, sel, min_prom_db, df_seg, n_modes, Y, fs):
             coh = min(mac_pair(u, v) for v in near) if near else 1.0
             cand = {"line": int(i), "sv": j, "f": float(f[i]), "prominence_db": float(prom),
                     "width_bins": float(wdt * (f[1] - f[0]) / df_seg), "coherence_mac": coh}
-            kurt = band_kurtosis(Y, fs, f[i], max(0.5 * wdt * (f[1] - f[0]), 10 * fs / Y.shape[1]), u)
+            hw = max(0.5 * wdt * (f[1] - f[0]), 10 * fs / Y.shape[1])
+            kurt = band_kurtosis(Y, fs, f[i], hw, u)
             cand["kurtosis"] = kurt
-            if kurt < TONE_KURTOSIS:
+            if harmonic_by_kurtosis(kurt, hw, Y.shape[1] / fs):
                 rejected.append(dict(cand, reason=f"a harmonic, not a mode: kurtosis {kurt:.2f} in its band (a "
                                                   "sinusoid gives 1.5, a mode's random response 3)"))
+            elif coh < 0.9 and floor > 0 and S[i, 0] >= UNRESOLVED_DB_OVER_FLOOR * floor:
+                # a resonance far above the noise whose singular vector turns within +-2 lines: more
+                # than one mode shares these lines, closer than the resolution separates
+                rejected.append(dict(cand, unresolved=True, reason=(
+                    f"two or more close modes share this peak: it stands {10 * np.log10(S[i, 0] / floor):.0f} dB "
+                    f"over the noise but its singular vector turns within +-2 lines (MAC {coh:.2f} < 0.9); the "
+                    f"resolution ({df_seg:.3g} Hz) does not separate them: oma_ssi resolves close modes")))
             elif coh < 0.9:
                 rejected.append(dict(cand, reason="singular vector not coherent around the peak (MAC < 0.9)"))
             elif j > 0 and any(abs(c["line"] - i) <= 2 or mac_pair(U[c["line"], :, c["sv"]], u) >= 0.8 for c in picked):
@@ -128,6 +142,7 @@ def _bell(S, U, cand, mac_bell):
     return bell, sorted(lines)
 
 
+UNRESOLVED_DB_OVER_FLOOR = 100.0   # 20 dB: an incoherent peak this far over the noise is close modes, not noise
 BIAS_ITERATIONS = 4   # fixed-point steps of the bell-cut bias correction (exact 57 Hz, 2 % bell: zeta to 0.011 %)
 POWER = {"displacement": 0, "velocity": 2, "acceleration": 4}   # an SDOF bell of each quantity: f^p |H|^2
 
@@ -166,17 +181,19 @@ def _efdd(bell, w, fs, nperseg, power=0):
     return dataclasses.replace(est, fn=np.array([fn]), zeta=np.array([z])), end, (fn0 - fn, z0 - z)
 
 
-def _efdd_fit(bell, w, fs, nperseg):
-    """Fit the bell's correlation function (a free decay) with the ring-down estimator."""
+def _efdd_fit(bell, w, fs, nperseg, end=None):
+    """Fit the bell's correlation function (a free decay) with the ring-down estimator, over ``end``
+    samples (default: until its envelope falls to a tenth, or the window's own correlation to 0.3)."""
     from ..ringdown import ringdown
     r = np.fft.irfft(bell)[:nperseg]
     wac = _window_autocorrelation(np.ascontiguousarray(w, float).tobytes())
     r = r / np.maximum(wac, 1e-12)
     r0 = r[0]
-    env = np.abs(_analytic(r[: nperseg // 2]))
-    low = np.flatnonzero(env[4:] < 0.1 * r0)
-    end = int(low[0]) + 4 if low.size else nperseg // 2
-    end = max(min(end, int(np.argmax(wac < 0.3)) or nperseg // 2), 64)
+    if end is None:
+        env = np.abs(_analytic(r[: nperseg // 2]))
+        low = np.flatnonzero(env[4:] < 0.1 * r0)
+        end = int(low[0]) + 4 if low.size else nperseg // 2
+        end = max(min(end, int(np.argmax(wac < 0.3)) or nperseg // 2), 64)
     import warnings
 
     from ...core.errors import QualityWarning
@@ -281,10 +298,13 @@ def oma_fdd(rec, *, band=None, nperseg: int | None = None, channels=None, n_mode
     return _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg, Gg)
 
 
-def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper):
+def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end):
     """Leave-one-group-out EFDD of one mode (the segments in N_GROUPS groups): jackknife std of fn
     and zeta of the plain fit, or None when fewer than all but one replicate succeed. (The bell-cut
-    bias correction shifts every replicate alike; the caller scales the std by its slope.)"""
+    bias correction shifts every replicate alike; the caller scales the std by its slope.) Every
+    replicate fits the decay over the full data's ``end`` samples: the jackknife needs an estimator
+    that moves smoothly with the data, and a decay length chosen again per replicate jumps (one
+    replicate of eight cut at 261 samples instead of 420 tripled a std)."""
     lo, hi = max(lines[0] - 5, 0), min(lines[-1] + 6, Gg.shape[1])
     tot = Gg[:, lo:hi].sum(axis=0)
     ref = U[c["line"], :, c["sv"]]
@@ -296,8 +316,9 @@ def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper):
         bell = np.zeros(Gg.shape[1])
         bell[lo:hi] = sub
         try:
-            e, _ = _efdd_fit(bell, w, fs, nper)
-            vals.append((e.fn[0], e.zeta[0]))
+            e, _ = _efdd_fit(bell, w, fs, nper, end)
+            if np.isfinite(e.fn[0]) and np.isfinite(e.zeta[0]):
+                vals.append((e.fn[0], e.zeta[0]))
         except (FitError, ParameterError):
             continue
     n = Gg.shape[0]
@@ -307,42 +328,56 @@ def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper):
     return np.sqrt((n - 1) / len(v) * np.sum((v - v.mean(axis=0)) ** 2, axis=0))
 
 
+def _efdd_mode(c, bell, lines, U, Gg, w, fs, nper, mac_bell, power):
+    """EFDD of one peak's bell with its jackknife std: ((fn, zeta, fn_std, zeta_std), flags, bias, decay
+    samples), or a reason string when the peak is refused (a harmonic, damping the data does not
+    determine)."""
+    fl, bias = [], None
+    try:
+        e, end, bias = _efdd(bell, w, fs, nper, power)
+        jk = _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end) if Gg is not None else None
+        if bias is None:
+            fl.append("bias_uncorrected")
+        elif jk is not None:
+            # the corrected estimate moves with the plain fit by about zeta / zeta_plain (the bias
+            # grows with zeta): the plain replicates' spread scaled by that slope
+            jk = (jk[0], jk[1] * e.zeta[0] / (e.zeta[0] + bias[1]))
+        stds = (e.fn_std[0], e.zeta_std[0]) if jk is None else (max(jk[0], e.fn_std[0]), max(jk[1], e.zeta_std[0]))
+        vals = (e.fn[0], e.zeta[0], *stds)
+        fl += [x for x in e.flags if x in ("few_cycles", "low_snr")]
+    except (FitError, ParameterError) as err:
+        if getattr(err, "tones_hz", None):
+            # the bell's correlation function does not decay: a harmonic, which the kurtosis test
+            # passed because noise shares its band
+            return (f"a harmonic, not a mode: the EFDD correlation function does not decay (a stationary tone "
+                    f"at {err.tones_hz[0]:.6g} Hz)")
+        vals, end = (c["f"], np.nan, np.nan, np.nan), 0
+        fl.append("efdd_failed")
+        c["efdd_error"] = str(err)
+    if np.isfinite(vals[1]) and vals[3] > MAX_REL_ZETA_STD * vals[1]:
+        c.update(zeta=float(vals[1]), zeta_std=float(vals[3]))
+        return f"damping relative std {vals[3] / vals[1]:.2f} > {MAX_REL_ZETA_STD}: the data does not support the mode"
+    if len(lines) < 5:
+        fl.append("resolution_limited")
+    return vals, fl, bias, end
+
+
 def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg, Gg):
     fn, zeta, fn_std, zeta_std, flags, bells = [], [], [], [], [], []
     power = POWER.get(rec.channels[0].quantity, 0)
-    kept = []
-    for c in picked:
+    kept, kept_lines = [], []
+    for c in sorted(picked, key=lambda c: -c["prominence_db"]):
         bell, lines = _bell(S, U, c, mac_bell)
-        fl, bias = [], None
-        try:
-            e, end, bias = _efdd(bell, w, rec.fs, nper, power)
-            jk = _efdd_jackknife(Gg, c, lines, U, mac_bell, w, rec.fs, nper) if Gg is not None else None
-            if bias is None:
-                fl.append("bias_uncorrected")
-            elif jk is not None:
-                # the corrected estimate moves with the plain fit by about zeta / zeta_plain (the bias
-                # grows with zeta): the plain replicates' spread scaled by that slope
-                jk = (jk[0], jk[1] * e.zeta[0] / (e.zeta[0] + bias[1]))
-            stds = (e.fn_std[0], e.zeta_std[0]) if jk is None else (max(jk[0], e.fn_std[0]), max(jk[1], e.zeta_std[0]))
-            vals = (e.fn[0], e.zeta[0], *stds)
-            fl += [x for x in e.flags if x in ("few_cycles", "low_snr")]
-        except (FitError, ParameterError) as err:
-            if getattr(err, "tones_hz", None):
-                # the bell's correlation function does not decay: a harmonic, which the kurtosis test
-                # passed because noise shares its band
-                rejected.append(dict(c, reason=f"a harmonic, not a mode: the EFDD correlation function does not "
-                                               f"decay (a stationary tone at {err.tones_hz[0]:.6g} Hz)"))
-                continue
-            vals, end = (c["f"], np.nan, np.nan, np.nan), 0
-            fl.append("efdd_failed")
-            c["efdd_error"] = str(err)
-        if np.isfinite(vals[1]) and vals[3] > MAX_REL_ZETA_STD * vals[1]:
-            rejected.append(dict(c, zeta=float(vals[1]), zeta_std=float(vals[3]),
-                                 reason=f"damping relative std {vals[3] / vals[1]:.2f} > {MAX_REL_ZETA_STD}: the data "
-                                        "does not support the mode"))
+        same = next((k for k, ln in zip(kept, kept_lines) if ln[0] <= c["line"] <= ln[-1]), None)
+        if same is not None:
+            # a lesser peak inside a kept mode's bell is that mode again (a noisy top has several)
+            rejected.append(dict(c, reason=f"the same mode as the {same['f']:.6g} Hz peak (inside its bell)"))
             continue
-        if len(lines) < 5:
-            fl.append("resolution_limited")
+        got = _efdd_mode(c, bell, lines, U, Gg, w, rec.fs, nper, mac_bell, power)
+        if isinstance(got, str):
+            rejected.append(dict(c, reason=got))
+            continue
+        vals, fl, bias, end = got
         if "few_cycles" not in fl and vals[0] * rec.n_samples / rec.fs < MIN_CYCLES:
             fl.append("few_cycles")   # its damping rests on fewer cycles than the rule asks
         for lst, v in zip((fn, zeta, fn_std, zeta_std), vals):
@@ -353,22 +388,34 @@ def _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band
                       "bias_removed_fn_hz": None if bias is None else bias[0],
                       "bias_removed_zeta": None if bias is None else bias[1]})
         kept.append(c)
+        kept_lines.append(lines)
     if not kept:
         raise FitError(f"oma_fdd: no mode in band={list(band)} that the data supports "
                        f"(rejected: {[(round(c['f'], 3), c['reason']) for c in rejected]})")
-    picked = kept
+    order = np.argsort([c["f"] for c in kept], kind="stable")
+    picked = [kept[k] for k in order]
+    fn, zeta, fn_std, zeta_std, flags, bells = ([lst[k] for k in order] for lst in (fn, zeta, fn_std, zeta_std,
+                                                                                   flags, bells))
     phi = _normalise(np.column_stack([U[c["line"], :, c["sv"]] for c in picked]))
     show = (f >= max(0.0, band[0] - 0.1 * (band[1] - band[0]))) & (f <= band[1] + 0.1 * (band[1] - band[0]))
     extras = {"peaks": picked, "rejected_modes": rejected, "rejected_peaks": rejected, "bells": bells, "band_hz": list(band), "nperseg": nper,
               "n_segments": n_seg, "outputs": names, "mpc": mpc(phi).tolist(), "mac": np.abs(_mac_matrix(phi)).tolist(),
               "singular_values": {"freq": f[show], "values": S[show].T, "unit": f"({rec.channels[0].unit})^2/Hz"},
               "rule": "peaks of the singular values standing min_prominence_db out, coherent singular vector "
-                      "(MAC >= 0.9 over +-2 lines), band kurtosis >= 2.2 (not a harmonic)",
-              "std_method": f"jackknife over {N_GROUPS} groups of segments (each left out, EFDD repeated); the "
+                      "(MAC >= 0.9 over +-2 lines), band kurtosis not below min(2.2, a random band's 0.1 % quantile) "
+                      "(not a harmonic); an incoherent peak 20 dB over the noise is close modes, reported",
+              "std_method": f"jackknife over {0 if Gg is None else Gg.shape[0]} groups of segments (each left out, EFDD repeated); the "
                             "ring-down fit's own std where larger" if Gg is not None else
                             "ring-down fit of the EFDD correlation function (white-error assumption: a lower bound)"}
+    unresolved = [c["f"] for c in rejected if c.get("unresolved")]
+    extras["unresolved_close_modes_hz"] = unresolved
     est = ModalEstimate(fn=fn, zeta=zeta, fn_std=fn_std, zeta_std=zeta_std, method="oma_fdd", mode_flags=tuple(flags),
-                        shapes=phi, unit=rec.channels[0].unit, extras=extras)
+                        flags=("unresolved_close_modes",) if unresolved else (), shapes=phi,
+                        unit=rec.channels[0].unit, extras=extras)
+    if unresolved:
+        warn_quality(f"oma_fdd: close modes near {', '.join(f'{x:.4g}' for x in unresolved)} Hz are not resolved at "
+                     f"this resolution and are left out (extras['rejected_modes']): run oma_ssi, which separates "
+                     "them, or give a longer record", stacklevel=3)
     if "bias_uncorrected" in est.flags:
         warn_quality("oma_fdd: the bias of cutting the bell could not be removed for some mode(s) (it would exceed "
                      "half of zeta: the bell is too narrow for the damping, or the exact bell's decay could not be "

@@ -12,7 +12,7 @@ from ...core.results import ModalEstimate
 from ..limits import MAX_REL_ZETA_STD
 from ..shapes import mac_pair, mpc, mpd
 from ._common import (CLUSTER_DF, CLUSTER_MAC, MAX_ZETA, MIN_CYCLES, MIN_MPC, STAB_DF, STAB_DZ, STAB_MAC, TONE_KURTOSIS,
-                      _check_duration, _normalise, _outputs, band_kurtosis)
+                      _check_duration, _normalise, _outputs, band_kurtosis, harmonic_by_kurtosis)
 
 
 # --- SSI-cov ------------------------------------------------------------------------------------
@@ -307,9 +307,10 @@ def oma_ssi(rec, *, band=None, max_order: int = 40, block_rows: int | None = Non
                        "record holds no resonance there, or too little of it (record longer, or raise max_order)")
     reps = [_representative(c) for c in modes]
     fn_std, zeta_std = _jackknife(S, cnt, s, l, fs_d, reps, Vt.T, sv)
-    kurt = [band_kurtosis(Y, rec.fs, rp["fn"], max(3 * rp["zeta"] * rp["fn"], 10 * rec.fs / Y.shape[1]), rp["phi"])
-            for rp in reps]
-    keep, rejected = _screen(reps, fn_std, zeta_std, kurt)
+    hw = [max(3 * rp["zeta"] * rp["fn"], 10 * rec.fs / Y.shape[1]) for rp in reps]
+    kurt = [band_kurtosis(Y, rec.fs, rp["fn"], h, rp["phi"]) for rp, h in zip(reps, hw)]
+    tone = [harmonic_by_kurtosis(k, h, Y.shape[1] / rec.fs) for k, h in zip(kurt, hw)]
+    keep, rejected = _screen(reps, fn_std, zeta_std, kurt, tone)
     if not keep:
         raise FitError(f"oma_ssi: no mode in band={band} that the data supports: "
                        + "; ".join(f"{d['fn_hz']:.5g} Hz: {d['reason']}" for d in rejected))
@@ -319,15 +320,16 @@ def oma_ssi(rec, *, band=None, max_order: int = 40, block_rows: int | None = Non
                              min_cluster=need, band_hz=list(band), rejected_modes=rejected))
 
 
-def _screen(reps, fn_std, zeta_std, kurt):
+def _screen(reps, fn_std, zeta_std, kurt, tone):
     """Modes whose damping the blocks reproduce (relative std <= the limit of
-    ringdown and fit_modes) and whose band is a random response, not a harmonic (band kurtosis >=
-    TONE_KURTOSIS); the others are listed with the reason."""
+    ringdown and fit_modes) and whose band is a random response, not a harmonic (``tone``: band
+    kurtosis below TONE_KURTOSIS and below a random band's 0.1 % quantile); the others are listed with
+    the reason."""
     keep, rejected = [], []
     for k, rp in enumerate(reps):
         rel = zeta_std[k] / rp["zeta"]
         rp["kurtosis"] = kurt[k]
-        if kurt[k] < TONE_KURTOSIS:
+        if tone[k]:
             why = (f"a harmonic, not a mode: the response in its band has kurtosis {kurt[k]:.2f} (a sinusoid gives "
                    "1.5, a mode's random response 3)")
         elif not np.isfinite(rel):
