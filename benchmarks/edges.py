@@ -208,6 +208,78 @@ def oma_cross_check_false_alarms():
     return f"{n} SSI modes on 20 records of the OMA benchmark: {disagree} methods_disagree, {unconfirmed} not_confirmed"
 
 
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
+
+
+def fit_modes_nested_bands():
+    rec = vm.read(SHARED / "impact" / "case1.mat")
+    rec = rec.replace(channels=(vm.Channel("Time_chan_1", "force"), vm.Channel("Time_chan_2")))
+    frf = vm.impact_frf(rec, input="Time_chan_1")
+    out = []
+    for band in ((20, 50), (10, 100), (10, 300), (10, 600)):
+        try:
+            est = vm.fit_modes(frf, band=band)
+        except vm.FitError as exc:
+            out.append(f"{band}: FitError {str(exc)[:60]}")
+            continue
+        k = int(np.argmin(np.abs(est.fn - 34.06)))
+        if abs(est.fn[k] - 34.06) < 0.1:
+            out.append(f"{band}: 34 Hz zeta {est.zeta[k]:.3g} +- {est.zeta_std[k]:.2g}")
+        else:
+            rej = [d for d in est.extras["rejected_modes"] if abs(d["fn_hz"] - 34.06) < 0.2]
+            out.append(f"{band}: 34 Hz refused ({rej[0]['reason'][:55] if rej else 'not found'})")
+    return "; ".join(out)
+
+
+def swept_sine_frf():
+    from scipy.signal import chirp
+    fs, out = 1000.0, []
+    for f0, f1, dur in ((1, 100, 20), (5, 60, 40), (1, 200, 10), (2, 80, 30)):
+        t = np.arange(int(dur * fs)) / fs
+        force = chirp(t, f0, dur, f1, method="logarithmic")
+        x = vm.synth.modal_response(force, fs=fs, fn=[25.0], zeta=[0.02], shapes=[[1.0]])[0]
+        rec = vm.Record(np.vstack([force, x]), fs=fs, channels=[vm.Channel("F", "force", "N"),
+                                                                 vm.Channel("x", "displacement", "m")])
+        est = vm.fit_modes(vm.estimate_frf(rec, input="F"), band=(10, 50))
+        out.append(f"{f0}-{f1} Hz in {dur} s: fn {np.round(est.fn, 3).tolist()} zeta {np.round(est.zeta, 4).tolist()}")
+    return "; ".join(out)
+
+
+def _duffing(k3_over_k, zeta=0.005, fn=10.0, fs=1000.0, T=12.0, noise=1e-3, friction=0.0, seed=0):
+    """Exact Duffing (and dry friction) decay of a unit mass released from x = 1 (solve_ivp, rtol 1e-10)."""
+    from scipy.integrate import solve_ivp
+    w0 = 2 * np.pi * fn
+    k, k3, c = w0 ** 2, k3_over_k * w0 ** 2, 2 * zeta * w0
+    t = np.arange(int(T * fs)) / fs
+
+    def f(_, y):
+        return [y[1], -c * y[1] - k * y[0] - k3 * y[0] ** 3 - friction * np.tanh(y[1] / (1e-3 * w0))]
+    x = solve_ivp(f, (0, T), [1.0, 0.0], t_eval=t, rtol=1e-10, atol=1e-12, method="DOP853").y[0]
+    return vm.Record.from_array(x + noise * np.random.default_rng(seed).standard_normal(t.size), fs=fs)
+
+
+def backbone_coverage():
+    out = []
+    cases = [(k3k, 0.0) for k3k in (0.02, 0.05, 0.1, 0.2)] + [(0.0, 3.0), (0.05, 3.0)]
+    for k3k, fric in cases:
+        zk, zf, zz, fits, modes = [], [], [], 0, []
+        for seed in range(34 if fric == 0 else 32):
+            est = vm.ringdown(_duffing(k3k, friction=fric, T=12.0 if fric == 0 else 6.0, seed=seed))
+            modes.append(est.n_modes)
+            m = est.extras.get("backbone_model", {}).get(0)
+            if not m or not m.get("fits", True):
+                continue
+            fits += 1
+            zk.append((m["k3_over_k"] - k3k) / m["k3_over_k_std"])
+            zz.append((m["zeta_viscous"] - 0.005) / m["zeta_viscous_std"])
+            if fric:
+                zf.append((m["friction_term"] - 2 * fric / (np.pi * (2 * np.pi * 10.0) ** 2)) / m["friction_term_std"])
+        rms = lambda z: f"{np.sqrt(np.mean(np.square(z))):.2f}" if z else "-"
+        out.append(f"k3/k {k3k} friction {fric}: modes {min(modes)}-{max(modes)}, model fits {fits}/{len(modes)}, "
+                   f"z-rms k3 {rms(zk)} zeta_v {rms(zz)}" + (f" friction {rms(zf)}" if fric else ""))
+    return "; ".join(out)
+
+
 def main():
     warnings.simplefilter("ignore")
     case("1. half_power on ring-downs (noise-free, worst over 9 phases)", half_power_bias)
@@ -224,6 +296,10 @@ def main():
     case("11. OMA close pair 1.23 / 1.29 Hz (tower, 600 s)", oma_close_pair)
     case("12. oma_fdd on the guide's 3-DOF chain, seed 1 (truth 7.083 / 19.846 / 28.679 Hz, zeta 0.02)", oma_chain_fdd)
     case("13. SSI-FDD cross-check false alarms", oma_cross_check_false_alarms)
+    case("14. fit_modes of case1.mat in nested bands", fit_modes_nested_bands)
+    case("15. swept-sine FRF (default estimate_frf) of one 25 Hz mode, zeta 0.02", swept_sine_frf)
+    case("16. backbone model on exact Duffing / friction decays (200 seeds): z = (estimate - truth) / std",
+         backbone_coverage)
 
 
 if __name__ == "__main__":

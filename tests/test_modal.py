@@ -182,10 +182,14 @@ def test_fit_modes_bad_input():
 
 
 # --- real data ------------------------------------------------------------------------------------
-def test_case1_hammer_frf_modes(shared_data):
+def _case1_frf(shared_data):
     rec = vm.read(shared_data("impact/case1.mat"))
     rec = rec.replace(channels=(vm.Channel("Time_chan_1", "force"), vm.Channel("Time_chan_2")))
-    frf = vm.impact_frf(rec, input="Time_chan_1")
+    return vm.impact_frf(rec, input="Time_chan_1")
+
+
+def test_case1_hammer_frf_modes(shared_data):
+    frf = _case1_frf(shared_data)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", vm.QualityWarning)
         est = vm.fit_modes(frf, band=(10, 600))
@@ -193,12 +197,40 @@ def test_case1_hammer_frf_modes(shared_data):
     assert est.fn[i2] == pytest.approx(212.1, abs=max(3 * est.fn_std[i2], 0.02))
     # 212 Hz: zeta 0.0009 within 10 % (one significant figure) and its std is stated
     assert est.zeta[i2] == pytest.approx(0.0009, rel=0.1) and est.zeta_std[i2] < 1e-4
-    # 34 Hz: its half-power band is 0.016 Hz on 0.31 Hz lines: its zeta is known to about +-100 %, so it
-    # is not reported as a mode; it is listed among the rejected ones with its frequency and the reason
-    assert all(abs(f - 34.06) > 1 for f in est.fn)
-    rej = [d for d in est.extras["rejected_modes"] if abs(d["fn_hz"] - 34.06) < 0.1]
-    assert len(rej) == 1 and "damping too uncertain" in rej[0]["reason"]
+    # 34 Hz: its half-power band (0.016 Hz) is far below the 0.31 Hz lines, but the exponential window
+    # (tau 0.69 s, known exactly) widens the peak to 1.5 lines and is taken off the pole: zeta 0.0002
+    # (the independent fits' one figure) within 3 of its stds, flagged resolution_limited
+    i1 = int(np.argmin(abs(est.fn - 34.06)))
+    assert est.fn[i1] == pytest.approx(34.06, abs=0.02)
+    assert abs(est.zeta[i1] - 0.0002) < max(3 * est.zeta_std[i1], 0.00005)
+    assert "resolution_limited" in est.mode_flags[i1]
     assert list(est.fn) == sorted(est.fn)  # frequency order
+
+
+def test_case1_modes_do_not_depend_on_how_far_the_band_reaches(shared_data):
+    """Each mode is fitted again from its own neighbourhood (60 decay rates or 20 lines), the others
+    subtracted, every line weighted by the residual's local level: a band that reaches further does
+    not move a mode's zeta or std. Before, the 34 Hz mode was 2.1e-4 +- 1.8e-5 in 20-50 Hz, refused as
+    'damping too uncertain' (3.7e-4 +- 2.3e-4) in 10-300 Hz and (1.7e-3 +- 1.8e-3) in 10-600 Hz, and the
+    212 Hz std moved fivefold (1.6e-6 to 9e-6). Now, over nested bands: the same modes, zeta within
+    one std of each other, stds within 25 % (measured 17 % and 19 %: the local noise estimate itself
+    scatters by ~8 %)."""
+    frf = _case1_frf(shared_data)
+    got = {34.06: [], 212.1: []}
+    for band in ((20, 50), (10, 100), (10, 300), (10, 600), (150, 250), (100, 300)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", vm.QualityWarning)
+            est = vm.fit_modes(frf, band=band)
+        for f0, lst in got.items():
+            if band[0] < f0 < band[1]:
+                k = int(np.argmin(abs(est.fn - f0)))
+                assert abs(est.fn[k] - f0) < 0.05, (band, est.fn)
+                lst.append((est.zeta[k], est.zeta_std[k]))
+    for f0, lst in got.items():
+        z, s = np.array(lst).T
+        assert len(z) >= 4
+        assert z.max() - z.min() <= s.mean(), (f0, lst)
+        assert s.max() <= 1.25 * s.min(), (f0, lst)
 
 
 def test_case2_spurious_pole_is_refused_with_its_test(shared_data):

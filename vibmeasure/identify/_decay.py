@@ -437,3 +437,31 @@ def half_power_crossings(freq, P, k, *, lower_msg: str):
     f1 = freq[lo] + (half - P[lo]) * (freq[lo + 1] - freq[lo]) / (P[lo + 1] - P[lo])
     f2 = freq[hi - 1] + (half - P[hi - 1]) * (freq[hi] - freq[hi - 1]) / (P[hi] - P[hi - 1])
     return float(f1), float(f2), lo, hi
+
+
+ALIVE_DB = 20.0   # a component is alive while its band holds this much more power than the noise would
+
+
+def alive_until(x: np.ndarray, fs: float, f0: float, sig: float, noise: float) -> int:
+    """Samples of ``x`` up to the end of the last half-overlapping block in which the component at
+    ``f0`` (decay rate ``sig``) still stands ALIVE_DB over white noise of std ``noise`` in its band
+    (+-max(3 decay rates, 5 % of f0)); blocks hold at least 4 cycles and resolve the band. An
+    exponential extrapolation of the start's decay rate cuts a decay whose damping falls with its
+    amplitude (a real beam: zeta 0.9 % at the start, 0.25 % after 12 s) long before it sinks."""
+    bw = max(3 * sig / (2 * np.pi), 0.05 * f0)
+    nper = int(min(x.size, 2 ** np.ceil(np.log2(max(4 * fs / f0, fs / bw, 16)))))
+    if nper < 16 or not noise > 0:
+        return 0
+    w = np.hanning(nper)
+    f = np.fft.rfftfreq(nper, 1 / fs)
+    sel = np.abs(f - f0) <= bw
+    sel[int(np.argmin(np.abs(f - f0)))] = True
+    p_noise = sel.sum() * noise ** 2 * float(np.sum(w ** 2))
+    starts = np.arange(0, x.size - nper + 1, max(nper // 2, 1))
+    if not starts.size:
+        return 0
+    seg = x[starts[:, None] + np.arange(nper)]
+    seg = seg - seg.mean(axis=1, keepdims=True)
+    p = np.sum(np.abs(np.fft.rfft(seg * w, axis=1)[:, sel]) ** 2, axis=1)
+    live = np.flatnonzero(p > 10 ** (ALIVE_DB / 10) * p_noise)
+    return int(starts[live[-1]] + nper) if live.size else 0

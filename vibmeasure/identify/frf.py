@@ -174,6 +174,14 @@ def estimate_frf(rec, *, input="force", outputs=None, estimator: str = "H1", npe
     if estimator not in ("H1", "H2", "Hv"):
         raise ParameterError(f"estimator={estimator!r} must be 'H1', 'H2' or 'Hv'")
     ii, oo = _io(rec, input, outputs)
+    sweep = _is_sweep(rec.data[ii[0]], rec.fs) if len(ii) == 1 else None
+    if sweep is not None and nperseg is None:
+        return _sweep_frf(rec, ii, oo, sweep)
+    if sweep is not None:
+        warn_quality(f"estimate_frf: the input is a swept sine ({sweep[0]:.4g} -> {sweep[1]:.4g} Hz): each of the "
+                     f"nperseg={nperseg} segments sees a part of the sweep and the ring-down of the parts before, "
+                     "which biases H (damping high, spurious peaks); leave nperseg unset for the one-block "
+                     "estimate a sweep needs", stacklevel=2)
     nperseg, noverlap, nfft = check_segment_params(rec.n_samples, nperseg, noverlap, None, detrend, "mean",
                                             min(rec.n_samples // 4, 4096) or 2)
     win = get_window(window, nperseg)
@@ -207,6 +215,64 @@ def estimate_frf(rec, *, input="force", outputs=None, estimator: str = "H1", npe
                tuple(rec.channels[i].name for i in ii), unit, err,
                {"window": window, "nperseg": nperseg, "noverlap": noverlap, "n_averages": nseg, "fs": rec.fs,
                 "detrend": detrend})
+
+
+SWEEP_SEGMENTS = 16     # the force's spectral centroid followed over this many blocks
+SWEEP_RANK = 0.95       # a sweep's centroid moves monotonically: |Spearman rank correlation with time| above this
+SWEEP_NARROW = 0.35     # and each block's spectral spread is below this share of the whole record's
+
+
+def _is_sweep(force, fs: float):
+    """(f_start, f_end) in Hz when the force is a swept sine, else None: over SWEEP_SEGMENTS blocks
+    the force's spectral centroid moves monotonically (rank correlation with time above SWEEP_RANK)
+    while each block is narrow-band (spread below SWEEP_NARROW of the whole record's). Random,
+    periodic-chirp and impact forces have the same spectrum in every block."""
+    from scipy.stats import spearmanr
+    x = np.asarray(force, float)
+    n = x.size // SWEEP_SEGMENTS
+    if n < 64 or np.ptp(x) == 0:
+        return None
+    blocks = (x[: n * SWEEP_SEGMENTS] - np.mean(x)).reshape(SWEEP_SEGMENTS, n) * np.hanning(n)
+    p = np.abs(np.fft.rfft(blocks, axis=1)) ** 2
+    f = np.fft.rfftfreq(n, 1 / fs)
+    tot = p.sum(axis=1)
+    live = tot > 1e-3 * tot.max()
+    if live.sum() < SWEEP_SEGMENTS // 2:
+        return None
+    c = (p[live] @ f) / tot[live]
+    spread = np.sqrt(np.maximum((p[live] @ f ** 2) / tot[live] - c ** 2, 0.0))
+    pa = p[live].sum(axis=0)
+    ca = pa @ f / pa.sum()
+    spread_all = np.sqrt(max(pa @ f ** 2 / pa.sum() - ca ** 2, 0.0))
+    rho = spearmanr(np.arange(c.size), c)[0]
+    if not (np.isfinite(rho) and abs(rho) > SWEEP_RANK and np.median(spread) < SWEEP_NARROW * spread_all):
+        return None
+    return float(c[0]), float(c[-1])
+
+
+def _sweep_frf(rec, ii, oo, sweep):
+    """A swept sine's FRF as one block: the ratio of the whole record's spectra, H = Y X* / |X|^2,
+    rectangular window (the sweep starts and ends in the record). Lines outside the sweep's range (the
+    force 30 dB under its peak power) are NaN. No averages: coherence and random error are
+    not estimated (NaN), and the FRF carries the flag swept_sine."""
+    x = rec.data[ii[0]] - np.mean(rec.data[ii[0]])
+    X = np.fft.rfft(x)
+    Y = np.fft.rfft(rec.data[oo] - np.mean(rec.data[oo], axis=1, keepdims=True), axis=1)
+    px = np.abs(X) ** 2
+    k = np.flatnonzero(px > 1e-3 * px.max())   # the sweep's range: its ends' ripples dip inside it
+    ok = np.zeros(px.size, bool)
+    ok[k[0]:k[-1] + 1] = True
+    ok &= px > 1e-12 * px.max()
+    H = np.full((len(oo), 1, X.size), np.nan, complex)
+    H[:, 0, ok] = Y[:, ok] * np.conj(X[ok]) / px[ok]
+    outs = [rec.channels[i] for i in oo]
+    forms = {form_of(c.quantity) for c in outs}
+    nan = np.full((len(oo), X.size), np.nan)
+    return FRF(np.fft.rfftfreq(x.size, 1 / rec.fs), H, forms.pop() if len(forms) == 1 else "unknown", nan, "H1",
+               tuple(c.name for c in outs), (rec.channels[ii[0]].name,), _frf_unit(outs, rec.channels[ii[0]]),
+               np.full(H.shape, np.nan),
+               {"window": "boxcar", "nperseg": x.size, "noverlap": 0, "n_averages": 1, "fs": rec.fs,
+                "sweep_hz": list(sweep), "flags": ("swept_sine",)})
 
 
 MAX_BUSY = 0.05   # an impact record's force is near zero except in its pulses: above 5 % it is continuous

@@ -17,8 +17,8 @@ from ..core._threads import single_threaded
 from ..core._validate import check_band, name_index
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import FRF, ModalEstimate
-from ._modal_fit import (FALSE_ALARM, MAX_REL_ZETA_STD, _covariance, _full_jacobian,  # noqa: F401 (tests, modal_crb)
-                         _lam, _lscf_poles, _polish, _residual_search, _residual_terms, _stabilise, _unsupported,
+from ._modal_fit import (FALSE_ALARM, LOCAL_LINES, MAX_REL_ZETA_STD, _covariance, _full_jacobian,  # noqa: F401 (tests, modal_crb)
+                         _lam, _local_refit, _lscf_poles, _polish, _residual_search, _residual_terms, _stabilise, _unsupported,
                          synthesize_frf_from)
 from ._poles import pole_to_modal
 
@@ -53,6 +53,18 @@ def _band_lines(frf: FRF, band, inp):
     # several inputs (poly-reference): every (output, input) FRF is a row sharing the poles
     H = frf.h[:, ii, sel] if isinstance(ii, int) else frf.h[:, ii, :][:, :, sel].reshape(-1, int(sel.sum()))
     bad = ~np.isfinite(H).all(axis=0)
+    if bad.any() and not bad.all():
+        # NaN lines at the band's ends are where the FRF has no data (a sweep's or a shaker's range): the
+        # band shrinks to the measured lines between them; a NaN line inside the measured range is damage
+        k = np.flatnonzero(~bad)
+        inner = np.zeros_like(bad)
+        inner[k[0]:k[-1] + 1] = True
+        if not bad[inner].any() and k.size >= 8:
+            f_in = frf.freq[sel][k]
+            sel = sel & (frf.freq >= f_in[0]) & (frf.freq <= f_in[-1])
+            H = H[:, k[0]:k[-1] + 1]
+            bad = bad[k[0]:k[-1] + 1]
+            lo, hi = max(lo, float(f_in[0])), min(hi, float(f_in[-1]))
     if bad.any():
         raise ParameterError(f"the FRF has {int(bad.sum())} NaN/inf line(s) in band={band!r} (first at "
                              f"{frf.freq[sel][bad][0]:g} Hz): cut the band or repair the data")
@@ -116,9 +128,9 @@ def fit_modes(frf: FRF, *, band, max_order: int = 40, n_modes: int | None = None
     table, clusters = _stabilise(poles)
     lam0 = _persistent_poles(clusters, len(poles), n_modes, band)
     w = 2 * np.pi * f
-    theta, coef, r, sw = _weighted_polish(w, H, lam0, n_modes)
+    theta, coef, r, sw, lw = _weighted_polish(w, H, lam0, n_modes)
     tau = frf.params.get("exp_window_tau_s")
-    theta, coef, r, cov, rejected = _screen(w, H, theta, coef, r, sw, tau, band, n_modes)
+    theta, coef, r, cov, rejected = _screen(w, H, theta, coef, r, sw, lw, tau, band, n_modes)
     m = _modal_parameters(theta, coef, cov, sw, tau)
     keep, flags_mode, dropped = _physical_modes(frf, f, band, theta, m)
     shapes, poly = _shapes(frf, ii, m, keep)
@@ -159,7 +171,8 @@ def _persistent_poles(clusters, n_orders, n_modes, band):
 
 def _weighted_polish(w, H, lam0, n_modes):
     """Maximum likelihood: a first pass with equal relative weights, then each output weighted by its
-    residual noise, then modes the residual still shows added."""
+    residual noise, modes the residual still shows added, then each line weighted by the residual's
+    local level (``_local_line_weights``)."""
     sw = 1 / np.sqrt(np.mean(np.abs(H) ** 2, axis=1))
     theta, coef, r = _polish(w, H, lam0, sw)
     nf = w.size
@@ -167,17 +180,38 @@ def _weighted_polish(w, H, lam0, n_modes):
     s_o = np.sqrt(np.sum(res ** 2, axis=1) / max(2 * nf - coef.shape[0] - 2 * lam0.size / H.shape[0], 1)) / sw
     sw = 1 / np.maximum(s_o, 1e-300)
     theta, coef, r = _polish(w, H, _lam(theta), sw)
+    # missed modes first: the local line weights would whiten a missing mode's residual away
     theta, coef, r, _ = _residual_search(w, H, theta, coef, r, sw, n_modes)
-    return theta, coef, r, sw
+    lw = _local_line_weights(r, H.shape[0], nf)
+    theta, coef, r = _polish(w, H, _lam(theta), sw, lw)
+    return theta, coef, r, sw, lw
 
 
-def _screen(w, H, theta, coef, r, sw, tau, band, n_modes):
+def _local_line_weights(r, n_out, nf):
+    """Each line weighted by 1 / (the residual's RMS over the +-LOCAL_LINES lines around it), normalised
+    to a mean square of 1. A measured FRF's noise is not the same over a wide band (a hammer's force
+    spectrum falls with frequency, a single average leaks most where |H| is high): with one weight per
+    output the lines of the noisiest region decide every mode's baseline, so a mode's estimate and
+    std moved with how far the band reached beyond it."""
+    from scipy.ndimage import uniform_filter1d
+    res = r.reshape(n_out, 2, nf)
+    p = np.sum(res ** 2, axis=(0, 1))
+    if nf < 4 * LOCAL_LINES or not np.any(p > 0):
+        return None   # too few lines to tell a local level from the band's
+    sm = uniform_filter1d(p, 2 * LOCAL_LINES + 1, mode="nearest")
+    sm = np.maximum(sm, 1e-6 * np.mean(sm))
+    lw = 1 / np.sqrt(sm)
+    return lw / np.sqrt(np.mean(lw ** 2))
+
+
+def _screen(w, H, theta, coef, r, sw, lw, tau, band, n_modes):
     """Refuse the poles the data does not support (Wald test of the residues, zeta known to 30 %, no
     stronger mode within two lines), refit without them, and again until none is refused."""
     f = w / (2 * np.pi)
     rejected: list[dict] = []
     for _round in range(theta.size // 2 + 1):
-        cov, s2 = _covariance(w, theta, coef, r, sw)
+        cov, s2 = _covariance(w, theta, coef, r, sw, lw)
+        theta, coef, cov = _local_refit(w, H, theta, coef, cov, sw, lw)
         out = _unsupported(theta, coef, cov, sw, tau, f.size, H.shape[0], band, float(np.median(np.diff(f))))
         if not out or n_modes is not None:
             break
@@ -187,7 +221,7 @@ def _screen(w, H, theta, coef, r, sw, tau, band, n_modes):
                            + "; ".join(f"{d['fn_hz']:.5g} Hz: {d['reason']}" for d in rejected))
         drop = {k for k, _ in out}
         lam_keep = np.array([l for k, l in enumerate(_lam(theta)) if k not in drop])
-        theta, coef, r = _polish(w, H, lam_keep, sw)
+        theta, coef, r = _polish(w, H, lam_keep, sw, lw)
     return theta, coef, r, cov, rejected
 
 

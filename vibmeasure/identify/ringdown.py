@@ -25,7 +25,8 @@ from ..core._validate import as_record, check_band, check_memory, clean_signal, 
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.record import Record
 from ..core.results import FLAG_TEXT, ModalEstimate
-from ._decay import band_noise_std, clipped_mask, decay_start, decimation_factor, trim_to_decay
+from ._decay import (alive_until, band_noise_std, clipped_mask, decay_start, decimation_factor, detrend_linear,
+                     noise_std, trim_to_decay)
 from ._poles import pole_to_modal
 from ._rd_checks import (_add_backbone, _amplitude_check, _coulomb_check, _dominant_cycles, _nonlinear_damping,
                          _overdamped_try)
@@ -95,6 +96,16 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     >>> round(float(est.fn[0]), 2), round(float(est.zeta[0]), 3)
     (10.37, 0.02)
     """
+    try:
+        return _ringdown(rec, channel, n_modes, band, start, max_modes, fs, progress)
+    except np.linalg.LinAlgError as exc:   # a fit gone to NaN or singular: said as the fit's failure
+        raise FitError(f"ringdown: the fit failed numerically ({exc}); the record may hold something the model "
+                       "of damped sinusoids plus offset and drift does not describe (a step, a saturation): "
+                       "give band= or start=, or cut the record") from None
+
+
+def _ringdown(rec, channel, n_modes, band, start, max_modes, fs, progress) -> ModalEstimate:
+    """The ring-down pipeline, one line per step."""
     d = _prepare(rec, channel, n_modes, band, start, max_modes, fs, progress)
     special = _special_cases(d)          # dry friction is another model; amplitude dependence, one mode
     if special is not None:
@@ -249,7 +260,9 @@ def _start_values(d: _Decay) -> _Start | None:
     c0 = int(np.flatnonzero(d.clip)[-1]) + 1 if d.clip.any() else 0
     if x.size - c0 < 64:
         raise FitError(f"only {x.size - c0} samples follow the last clipped one: too few to fit a decay")
-    xs = x[c0:]
+    # the start values see the oscillation without its offset and drift (the fit models both): a drift
+    # of a few % of the peak took the subspace's leading directions and lost a real beam's fundamental
+    xs = detrend_linear(x[c0:])
     try:
         s = _esprit(xs, fsr, d.max_modes, d.n_modes)
     except np.linalg.LinAlgError as exc:
@@ -307,6 +320,11 @@ def _trim_to_noise_floor(d: _Decay, s: _Start) -> None:
     if s.noise and (s.sig > 0).all():
         t_floor = np.max(np.log(np.maximum(np.hypot(s.a, s.b) / (0.3 * floor), 1.0)) / s.sig)
         n_end = int(min(d.x.size, max(np.ceil(t_floor * d.fsr) + 1, 64)))
+        # the extrapolation never cuts a component the data shows alive (a decay whose damping falls
+        # with its amplitude outlives its start's rate): the longest-lived one is followed in blocks
+        k = int(np.argmax(np.where(np.isfinite(floor), 1.0 / s.sig, -np.inf)))
+        broad = noise_std(d.x, d.fsr)
+        n_end = max(n_end, min(d.x.size, alive_until(d.x, d.fsr, s.om[k] / (2 * np.pi), s.sig[k], broad)))
         if n_end < d.x.size and "noise_floor" not in d.flags:
             d.flags.append("noise_floor")
     d.x, d.w = d.x[:n_end], d.w[:n_end]
@@ -548,4 +566,4 @@ def _warn_flags(est: ModalEstimate, rejected):
     if rejected:
         msgs.append(f"{len(rejected)} mode(s) left out: damping relative std above {MAX_REL_ZETA_STD}")
     if msgs:
-        warn_quality("ringdown: " + "; ".join(msgs), stacklevel=4)
+        warn_quality("ringdown: " + "; ".join(msgs), stacklevel=7)

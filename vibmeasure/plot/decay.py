@@ -201,7 +201,7 @@ def plot_backbone(est: ModalEstimate, *, mode: int = 0, axes=None):
     axes[0].errorbar(A, b["fn_hz"], yerr=b["fn_std_hz"], fmt="o", ms=3, lw=1, label="windows")
     axes[1].errorbar(A, b["zeta"], yerr=b["zeta_std"], fmt="o", ms=3, lw=1, label="windows")
     model = est.extras.get("backbone_model", {}).get(mode)
-    if model:
+    if model and model.get("fits", True):   # a model that does not fit the windows is not drawn
         a = np.linspace(A.min(), A.max(), 200)
         w2 = (2 * np.pi * model["fn0_hz"]) ** 2 + 0.75 * model["k3_over_m"] * a ** 2
         axes[0].plot(a, np.sqrt(np.maximum(w2, 0)) / (2 * np.pi), "r-", lw=1, label="Duffing model")
