@@ -16,12 +16,13 @@ from ._common import (CLUSTER_DF, CLUSTER_MAC, MAX_ZETA, MIN_CYCLES, MIN_MPC, ST
 
 
 # --- SSI-cov ------------------------------------------------------------------------------------
-def _decimate(Y, fs, band):
+def _decimate(Y, fs, band, q_max):
     """Low-pass and decimate so that the band's top sits near 0.4 fs (SSI resolves the band with fewer
-    block rows); the continuous poles are unchanged."""
+    block rows), at most by q_max (the covariances' blocks must keep their samples); the continuous
+    poles are unchanged."""
     if band is None:
         return Y, fs, 1
-    q = int(np.floor(0.4 * fs / band[1]))
+    q = min(int(np.floor(0.4 * fs / band[1])), int(q_max))
     if q < 2:
         return Y, fs, 1
     from scipy.signal import resample_poly
@@ -291,7 +292,8 @@ def oma_ssi(rec, *, band=None, max_order: int = 40, block_rows: int | None = Non
     band = check_band(band, rec.fs) or (0.0, rec.fs / 2)
     orders, s, n_blocks = _ssi_sizes(max_order, block_rows, n_blocks, l)
     _check_duration(Y.shape[1], rec.fs, band[1], "oma_ssi")
-    Yd, fs_d, q = _decimate(Y, rec.fs, band if band[1] < rec.fs / 2 else None)
+    # a narrow low band would decimate a record below what the blocks need: decimate less instead
+    Yd, fs_d, q = _decimate(Y, rec.fs, band if band[1] < rec.fs / 2 else None, Y.shape[1] // (8 * n_blocks * s))
     if Yd.shape[1] < 8 * n_blocks * s:
         # each jackknife block must hold several times the 2 s lags of the covariances
         raise ParameterError(f"oma_ssi: {Yd.shape[1]} samples (after decimation by {q}) are too few for "
