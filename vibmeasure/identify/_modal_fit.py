@@ -383,7 +383,7 @@ def _residual_terms(coef, sw, m) -> list[dict]:
 
 
 
-def _local_refit(w, H, theta, coef, cov, sw, lw):
+def _local_refit(w, H, theta, coef, cov, sw):
     """Each mode again from its own neighbourhood: the lines within LOCAL_LINES (or LOCAL_SIGMAS decay
     rates) of it, the other modes' fitted contributions subtracted and a local set of residual
     terms fitted beside it. Its pole, residues and their covariance replace the band fit's (cross
@@ -408,13 +408,14 @@ def _local_refit(w, H, theta, coef, cov, sw, lw):
         others = [c for c in range(2 * m) if c // 2 != k]
         Hk = (H * sw[:, None])[:, near] - (B[near][:, others] @ coef[others]).T
         try:
-            th, c, r = _polish(w[near], Hk / sw[:, None], _lam(theta[2 * k:2 * k + 2]), sw,
-                               None if lw is None else lw[near])
-            ck, _ = _covariance(w[near], th, c, r, sw, None if lw is None else lw[near])
+            # uniform weights inside the neighbourhood: the band's line weights come from the band's
+            # residual, and the mode's fit must not depend on what lies beyond its neighbourhood
+            th, c, r = _polish(w[near], Hk / sw[:, None], _lam(theta[2 * k:2 * k + 2]), sw)
+            ck, _ = _covariance(w[near], th, c, r, sw)
         except (np.linalg.LinAlgError, ValueError):
             continue
-        if not (abs(th[1] - wd) < half and 0 < th[0] < half):
-            continue
+        if not (abs(th[1] - wd) < max(2 * sig, 2 * dw) and 0 < th[0] < 3 * sig + dw):
+            continue   # the local fit moved the pole out of the mode's own peak: the band fit stands
         idx = [2 * k, 2 * k + 1] + [2 * m + p_lin * o + 2 * k + j for o in range(n_out) for j in (0, 1)]
         loc = [0, 1] + [2 + 8 * o + j for o in range(n_out) for j in (0, 1)]
         theta[2 * k:2 * k + 2] = th

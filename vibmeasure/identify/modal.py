@@ -211,7 +211,7 @@ def _screen(w, H, theta, coef, r, sw, lw, tau, band, n_modes):
     rejected: list[dict] = []
     for _round in range(theta.size // 2 + 1):
         cov, s2 = _covariance(w, theta, coef, r, sw, lw)
-        theta, coef, cov = _local_refit(w, H, theta, coef, cov, sw, lw)
+        theta, coef, cov = _local_refit(w, H, theta, coef, cov, sw)
         out = _unsupported(theta, coef, cov, sw, tau, f.size, H.shape[0], band, float(np.median(np.diff(f))))
         if not out or n_modes is not None:
             break
