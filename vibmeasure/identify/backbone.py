@@ -8,7 +8,7 @@ Fisher information. The backbone is that table.
 
 The model (first-order harmonic balance / averaging, amplitude A of the displacement-like signal):
     wn(A)^2           = w0^2 + (3/4) (k3/m) A^2 + c4 A^4        (cubic stiffness k3; c4 the next order)
-    zeta(A) wn(A)/w0  = zeta_v + f_c / A + q A                  (viscous, dry friction, quadratic)
+    zeta(A) wn(A)/w0  = zeta_v + f_c / A + q A + r A^2          (viscous, dry friction, quadratic; r nuisance)
 with f_c = 2 F_c / (pi k) and q = 4 c2 w / (3 pi k) in terms of the friction force F_c and the
 quadratic damping coefficient c2 (the damping terms act on the decay rate: a viscous damper's zeta
 falls as a stiffening spring raises wn). Both relations are linear in their unknowns, fitted by
@@ -223,8 +223,10 @@ def fit_backbone(bb) -> dict:
     cw, sw, chi_w = wls(np.column_stack([np.ones_like(A), 0.75 * A ** 2, A ** 4]), w ** 2, 2 * w * w_std)
     w0 = float(np.sqrt(max(cw[0], 1e-300)))
     # the damping terms act on the decay rate zeta w: a viscous c gives zeta w = c / 2m at every
-    # amplitude, so zeta itself falls as a stiffening spring raises w (z w / w0 is fitted; zeta_v at w0)
-    cz, sz, chi_z = wls(np.column_stack([np.ones_like(A), 1 / A, A]), z * w / w0, z_std * w / w0)
+    # amplitude, so zeta itself falls as a stiffening spring raises w (z w / w0 is fitted; zeta_v at w0).
+    # An A^2 term (cubic damping, and the windows' own second-order error on a chirping decay) is a
+    # nuisance: without it zeta_v came out 1-2 of its stds high at k3/k 0.1-0.2
+    cz, sz, chi_z = wls(np.column_stack([np.ones_like(A), 1 / A, A, A ** 2]), z * w / w0, z_std * w / w0)
     k3_std = float(np.hypot(sw[1], K3_MODEL_ERROR * cw[1]))
     model = {"fn0_hz": w0 / (2 * np.pi), "fn0_std_hz": float(sw[0] / (2 * w0) / (2 * np.pi)),
              "k3_over_m": float(cw[1]), "k3_over_m_std": k3_std,
@@ -244,7 +246,7 @@ def _lack_of_fit(chi_w: float, chi_z: float, n: int, model: dict, a_min: float):
     at the smallest amplitude (a Duffing decay's harmonics leave one of -1 % there)."""
     from scipy.stats import chi2
     out = []
-    for name, c, dof in (("frequency", chi_w, n - 3), ("damping", chi_z, n - 3)):
+    for name, c, dof in (("frequency", chi_w, n - 3), ("damping", chi_z, n - 4)):
         limit = GOF_FACTOR * float(chi2.ppf(0.99, max(dof, 1))) / max(dof, 1)
         if not c <= limit:
             out.append(f"the {name} model leaves reduced chi-square {c:.3g} > {limit:.3g}")
