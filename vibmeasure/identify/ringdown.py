@@ -519,10 +519,13 @@ def _assemble(d: _Decay, f: _Fit, c: _Modes) -> ModalEstimate:
     _nonlinear_checks(d, f, c, ik, extras, fn_r, zeta_r, zeta_std_r)
     resid_all = d.x - f.model
     tables = []
-    for j, k in enumerate(ik):  # every reported mode, isolated from the others
+    for j, k in enumerate(ik):  # every reported mode, isolated from the other reported modes
         if np.isfinite(zeta_r[j]):
-            tables.append(_add_backbone(extras, c.mode_flags[j], resid_all + _mode_model(f.p, k, d.t), d.fsr,
-                                        f.fn[k], f.zeta[k], f.noise, j))
+            # unreported components within 20 % of the mode are part of it: a chirping (nonlinear) decay
+            # is fitted as a mode plus a close helper that takes up its frequency change
+            own = [k] + [i for i in range(f.fn.size) if i not in ik and abs(f.fn[i] / f.fn[k] - 1) < 0.2]
+            iso = resid_all + sum(_mode_model(f.p, i, d.t) for i in own)
+            tables.append(_add_backbone(extras, c.mode_flags[j], iso, d.fsr, f.fn[k], f.zeta[k], f.noise, j))
     tables = [b for b in tables if b is not None]
     if tables:
         import pandas as pd
