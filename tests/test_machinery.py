@@ -800,3 +800,24 @@ def test_shaft_harmonics_that_carry_little_of_the_level_are_no_looseness(shared_
     loose = vm.diagnose(vm.synth.machine(fault="looseness", snr_db=-10, seed=1, duration=6.0))
     lrow = loose.faults.set_index("fault").loc["looseness"]
     assert loose.top == "looseness" and float(lrow.note.split("they carry ")[1].split(" %")[0]) >= 50
+
+
+def test_channels_names_the_only_channels_searched():
+    """``channels=[...]`` mixed the record's first channel in: a healthy sensor named alone inherited the
+    outer-race fault of the first channel (called at 1.00, reason naming 'faulty+healthy'). The named
+    channels are now the only ones searched, the first of them the primary unless ``channel`` says
+    otherwise, and ``extras['channels_used']`` lists them."""
+    f = vm.synth.machine(fault="bearing_outer_race", rpm=1797, duration=4.0, seed=1)
+    h = vm.synth.machine(fault="none", rpm=1797, duration=4.0, seed=2)
+    unit = f.channels[0].unit
+    rec = vm.Record(np.vstack([f.data[0], h.data[0]]), fs=f.fs,
+                    channels=[vm.Channel("faulty", "acceleration", unit), vm.Channel("healthy", "acceleration", unit)])
+    both = vm.diagnose(rec, rpm=1797, bearing="6205-2RS")
+    assert both.top == "bearing_outer_race" and both.extras["channels_used"] == ["faulty", "healthy"]
+    alone = vm.diagnose(rec, rpm=1797, bearing="6205-2RS", channels=["healthy"])
+    assert alone.top != "bearing_outer_race" and alone.extras["channels_used"] == ["healthy"]
+    assert alone.channel == "healthy"
+    other = vm.diagnose(rec, rpm=1797, bearing="6205-2RS", channel="faulty", channels=["healthy"])
+    assert other.extras["channels_used"] == ["healthy"] and other.top != "bearing_outer_race"
+    with pytest.raises(vm.ParameterError, match="names no channel"):
+        vm.diagnose(rec, rpm=1797, bearing="6205-2RS", channels=[])

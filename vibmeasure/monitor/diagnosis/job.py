@@ -145,6 +145,15 @@ def _quality_note(quality: dict) -> str:
 def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band, prewhitening,
              line_frequency, skip=()) -> Job:
     """``skip``: channels that are no vibration (a tachometer), left out unless named."""
+    named = None
+    if channels is not None:
+        # the channels a user names are the only ones searched; the first of them is the primary
+        # (speed, severity, shaft orders) unless ``channel`` names another
+        named = [rec.index(c) for c in ([channels] if isinstance(channels, (str, int)) else channels)]
+        if not named:
+            raise ParameterError("channels=[] names no channel: give at least one, or leave it out for all")
+        if channel is None:
+            channel = named[0]
     if channel is None and skip:
         left = [i for i, c in enumerate(rec.channels) if i not in skip and c.quantity != "force"]
         if not left:
@@ -180,12 +189,12 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
     ftf = bearing.frequencies(f1)["FTF"] if bearing is not None else TYPICAL_FTF_ORDER * f1
     block = (max(64, int(round(2 * rec.fs / f1))), max(64, int(round(2 * rec.fs / ftf))))
     a = _accel(rec, idx, flags, quality, block)
-    if channels is None:
+    if named is None:
         chosen = [i for i, c in enumerate(rec.channels) if c.quantity not in ("force", "time") and i not in skip]
+        if idx not in chosen:
+            chosen.insert(0, idx)
     else:
-        chosen = [rec.index(c) for c in ([channels] if isinstance(channels, (str, int)) else channels)]
-    if idx not in chosen:
-        chosen.insert(0, idx)
+        chosen = list(dict.fromkeys(named))
     signals = {rec.channels[i].name: (a if i == idx else _accel(rec, i, flags, quality, block))
                for i in chosen}
     if band is not None:

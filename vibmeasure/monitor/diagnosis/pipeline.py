@@ -61,7 +61,9 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     channel : str or int, optional
         The channel for speed, severity and shaft orders (default the first that is not a force).
     channels : str, int or list, optional
-        The channels searched for bearing faults (default every vibration channel).
+        The channels searched for bearing faults (default every vibration channel): only these; the
+        first of them is also the primary channel unless ``channel`` names another.
+        ``extras["channels_used"]`` lists them.
     band : tuple of float, optional
         A fixed demodulation band (Hz); default the whole band, the kurtogram's and the infogram's.
     prewhitening : str or tuple of str
@@ -157,7 +159,8 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
                    + " (above: a filter's stop band): the envelope bands reach down among the shaft harmonics")
     if job.bearing is None or contradicted:
         job.flags.append("bearing_not_checked")
-    extras = {"also": also, "primary": job.primary, "score": score, "confidence_kind": kind}
+    extras = {"also": also, "primary": job.primary, "score": score, "confidence_kind": kind,
+              "channels_used": list(job.signals)}
     if job.quality:
         note = _quality_note(job.quality)
         reason += "; data: " + note
