@@ -403,8 +403,8 @@ def _local_refit(w, H, theta, coef, cov, sw):
         sig, wd = theta[2 * k], theta[2 * k + 1]
         half = max(LOCAL_LINES * dw, LOCAL_SIGMAS * sig)
         near = np.abs(w - wd) <= half
-        if near.sum() < 16:
-            continue
+        if near.sum() < 16 or near.mean() > 0.8:
+            continue   # too few lines, or the neighbourhood is most of the band: the band fit is local
         others = [c for c in range(2 * m) if c // 2 != k]
         Hk = (H * sw[:, None])[:, near] - (B[near][:, others] @ coef[others]).T
         try:

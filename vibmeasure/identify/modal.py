@@ -183,7 +183,10 @@ def _weighted_polish(w, H, lam0, n_modes):
     # missed modes first: the local line weights would whiten a missing mode's residual away
     theta, coef, r, _ = _residual_search(w, H, theta, coef, r, sw, n_modes)
     lw = _local_line_weights(r, H.shape[0], nf)
-    theta, coef, r = _polish(w, H, _lam(theta), sw, lw)
+    if lw is not None and lw.max() > 1.5 * lw.min():   # near-uniform weights would change nothing
+        theta, coef, r = _polish(w, H, _lam(theta), sw, lw)
+    else:
+        lw = None
     return theta, coef, r, sw, lw
 
 
