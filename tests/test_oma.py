@@ -259,13 +259,8 @@ def test_the_duration_rule_is_on_the_modes_and_fdd_has_ssis_defaults():
 
 
 def _close_pair_tower(seed):
-    """Four modes like a tall building's (two bending modes 0.06 Hz apart, torsion, a higher bending),
-    random orthonormal shapes over 6 dofs, 4 sensors, 600 s at 20 Hz."""
-    fns = np.array([1.23, 1.29, 1.45, 3.86, 6.0, 7.5])
-    phi, _ = np.linalg.qr(np.random.default_rng(5).standard_normal((6, 6)))
-    k = phi @ np.diag((2 * np.pi * fns) ** 2) @ phi.T
-    model = vm.models.MDOF(np.eye(6), (k + k.T) / 2, modal_zeta=[0.012, 0.015, 0.012, 0.015, 0.02, 0.02])
-    return vm.synth.ambient(model, fs=20.0, duration=600.0, noise=0.05, seed=seed, outputs=[0, 1, 2, 3])
+    from edges import tower   # the edge benchmark's tower (benchmarks/ is on the path, as for `system`)
+    return tower(seed)
 
 
 def test_fdd_reports_close_modes_it_cannot_resolve_and_the_cross_check_names_them():
