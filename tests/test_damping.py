@@ -152,16 +152,21 @@ def test_log_decrement_with_a_band_stays_on_the_mode_despite_an_offset(shared_da
 
 def test_half_power_of_an_frf_ignores_nan_lines_outside_its_band():
     """A swept-sine FRF holds NaN where the sweep had no power (estimate_frf leaves them): the peak at
-    30 Hz is measured when the NaN lines lie outside the band (exact relation for mobility: zeta 0.02 to
-    within 0.1 %, interpolation between 4000 lines), refused by name when they lie inside it."""
+    30 Hz is measured when the NaN lines lie outside the band or at its ends (the band shrinks to the
+    measured lines, as fit_modes does; exact relation for mobility: zeta 0.02 to within 0.1 %,
+    interpolation between 4000 lines), refused by name when a NaN line lies between measured ones."""
     import dataclasses
     h = vm.synth.modal_frf(np.linspace(1, 100, 4000), fn=[30.0], zeta=[0.02], shapes=[[1.0]], form="mobility")
     holed = h.h.copy()
     holed[..., :200] = np.nan                                  # 1-5.9 Hz: no power there
-    h = dataclasses.replace(h, h=holed)
-    assert vm.half_power(h, band=(20, 40)).zeta[0] == pytest.approx(0.02, rel=1e-3)
+    ends = dataclasses.replace(h, h=holed)
+    assert vm.half_power(ends, band=(20, 40)).zeta[0] == pytest.approx(0.02, rel=1e-3)
+    assert vm.half_power(ends, band=(1, 40)).zeta[0] == pytest.approx(0.02, rel=1e-3)
+    assert vm.half_power(ends).zeta[0] == pytest.approx(0.02, rel=1e-3)
+    hole = h.h.copy()
+    hole[..., 700:720] = np.nan                                # a gap at 18.3-18.8 Hz, inside the band
     with pytest.raises(vm.ParameterError, match="NaN/inf lines inside band"):
-        vm.half_power(h, band=(1, 40))
+        vm.half_power(dataclasses.replace(h, h=hole), band=(1, 40))
 
 
 def test_log_decrement_flags_several_modes_in_its_band():

@@ -199,8 +199,12 @@ def half_power_frf(obj, *, band=None, output=0, input=0) -> ModalEstimate:
     sel &= freq > 0
     if not sel.any():
         raise ParameterError(f"band={band!r} holds no line of the data")
-    # NaN lines outside the band (a swept sine leaves them where it had no power) do not matter
+    # NaN lines outside the band (a swept sine leaves them where it had no power) do not matter, nor those
+    # at the band's ends: the band shrinks to the measured lines between them
     finite = np.isfinite(P)
+    k = np.flatnonzero(sel & finite)
+    if k.size and finite[k[0]:k[-1] + 1][sel[k[0]:k[-1] + 1]].all():
+        sel = sel & (np.arange(sel.size) >= k[0]) & (np.arange(sel.size) <= k[-1])
     if not finite[sel].all():
         raise ParameterError(f"the FRF/spectrum has NaN/inf lines inside band={band!r}: narrow the band")
     k = int(np.flatnonzero(sel)[np.argmax(P[sel])])
