@@ -843,3 +843,20 @@ def test_a_drift_does_not_raise_the_iso_velocity(shared_data, drift):
     assert drifting.severity["velocity_rms_mm_s"] == pytest.approx(clean.severity["velocity_rms_mm_s"], rel=0.01)
     assert drifting.severity["zone"] == clean.severity["zone"] == "A"
     assert drifting.top == clean.top
+
+
+def test_a_doubtful_time_base_holds_the_confidence_and_withdraws_the_zone(shared_data):
+    """CWRU Normal_0 is sampled at 48 kHz; read at 12 kHz its lines fit the declared speed only at 4x fs
+    (flag speed_inconsistent), yet it was answered 'none' at 0.97 with a zone from a velocity four times
+    too high. Every frequency the answer rests on may be off by that factor: the confidence stays under
+    0.5 (0.45) and no zone is given; read at its own rate nothing changes."""
+    path = shared_data("cwru/Normal_0.mat")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        rec = vm.read(path, fs=12000, unit="g")
+        de = next(n for n in rec.names if n.endswith("_DE_time"))
+        wrong = vm.diagnose(rec, rpm=rec.meta["rpm"], bearing="6205-2RS", channel=de)
+        right = vm.diagnose(vm.read(path, fs=48000, unit="g"), rpm=rec.meta["rpm"], bearing="6205-2RS", channel=de)
+    assert "speed_inconsistent" in wrong.flags and wrong.speed["fs_ratio"] == 4
+    assert wrong.confidence <= 0.45 and wrong.severity["zone"] is None and "time base is in doubt" in wrong.reason
+    assert right.confidence > 0.9 and right.severity["zone"] == "A"

@@ -115,6 +115,29 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     return _answer(run, rows, ev, severity, narrow, contradicted)
 
 
+DOUBT_CONFIDENCE = 0.45   # an answer whose time base is in doubt stays under the 0.5 a confident answer needs
+
+
+def _time_base_doubt(speed: dict, severity: dict, conf: float, reason: str) -> tuple[float, str]:
+    """When the lines fit the declared speed only at another fs (or another speed by the same factor:
+    rpm for Hz, pulses per revolution), every frequency the answer rests on may be off by that factor:
+    the confidence is held under DOUBT_CONFIDENCE and the ISO zone withdrawn (the velocity scales with
+    the time base). Before, CWRU Normal_0 read at a quarter of its rate was answered 'none' at 0.97
+    with a zone from a velocity four times too high."""
+    r = speed.get("fs_ratio", 1)
+    if r == 1:
+        return conf, reason
+    if severity.get("zone") is not None:
+        severity["zone"] = None
+        severity["note"] = "; ".join(filter(None, [severity.get("note", ""), (
+            f"no zone: the time base is in doubt (the lines fit only at {r}x fs, or {r}x the declared speed)")]))
+    if conf > DOUBT_CONFIDENCE:
+        reason += (f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f}): the time base is in doubt, check fs "
+                   f"and the speed (a factor {r}: rpm for Hz, pulses per revolution)")
+        conf = DOUBT_CONFIDENCE
+    return conf, reason
+
+
 def _tracked_speed(rec, tach, rpm_profile, pulses_per_rev) -> dict | None:
     """The speed a tachometer or an rpm profile measures, or None when neither is given."""
     if tach is None and rpm_profile is None:
@@ -147,6 +170,7 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     unweighed = _unweighed(rows) if "unit_unknown" in job.flags else None
     table = pd.DataFrame(rows).sort_values("confidence", ascending=False, ignore_index=True)
     top, conf, reason, also, where, (kind, score, parts) = _decide(table, job, weak)
+    conf, reason = _time_base_doubt(speed, severity, conf, reason)
     if unweighed:
         reason += (f"; shaft-order faults not called: the data's unit is unknown, so the ISO 10816-3 level that "
                    f"shows whether they matter cannot be computed (give unit=, e.g. 'g'); strongest pattern "
