@@ -188,6 +188,10 @@ def test_swept_sine_frf_is_one_block_and_fits_one_mode(f0, f1, duration):
     assert hp.fn[0] == pytest.approx(25.0, rel=1e-3) and hp.zeta[0] == pytest.approx(0.02, rel=0.03)
     with pytest.warns(vm.QualityWarning, match="swept sine"):
         vm.estimate_frf(rec, input="F", nperseg=2048)
+    # a damaged response is refused by name on the one-block path too (it returned an FRF of NaN)
+    bad = vm.Record(np.vstack([force, np.where(t > 5, np.nan, x)]), fs=fs, channels=rec.channels)
+    with pytest.raises(vm.ParameterError, match="output channel 'x' has .* NaN/inf samples"):
+        vm.estimate_frf(bad, input="F")
 
 
 def test_random_and_impact_forces_are_not_sweeps():

@@ -255,6 +255,9 @@ def _sweep_frf(rec, ii, oo, sweep):
     rectangular window (the sweep starts and ends in the record). Lines outside the sweep's range (the
     force 30 dB under its peak power) are NaN. No averages: coherence and random error are
     not estimated (NaN), and the FRF carries the flag swept_sine."""
+    from ..core._validate import clean_signal
+    for o in oo:   # the outputs obey the rule the segment path applies: finite, not constant
+        clean_signal(rec, o, min_samples=16, what="output")
     x = rec.data[ii[0]] - np.mean(rec.data[ii[0]])
     X = np.fft.rfft(x)
     Y = np.fft.rfft(rec.data[oo] - np.mean(rec.data[oo], axis=1, keepdims=True), axis=1)
