@@ -860,3 +860,38 @@ def test_a_doubtful_time_base_holds_the_confidence_and_withdraws_the_zone(shared
     assert "speed_inconsistent" in wrong.flags and wrong.speed["fs_ratio"] == 4
     assert wrong.confidence <= 0.45 and wrong.severity["zone"] is None and "time base is in doubt" in wrong.reason
     assert right.confidence > 0.9 and right.severity["zone"] == "A"
+
+
+@pytest.mark.parametrize("unit,integrations", [("mm/s", 1), ("in/s", 1), ("um", 2), ("mil", 2)])
+def test_velocity_and_displacement_channels_are_differentiated_not_read_as_acceleration(shared_data, unit,
+                                                                                          integrations):
+    """A channel in mm/s or um was analysed as if it were acceleration (CWRU IR007 called inner race from
+    the wrong spectrum, the ISO velocity from a double-integrated displacement) with the flag
+    unit_unknown. Integrated once or twice from the g record and declared in its own unit, it is
+    differentiated back: the same answer, and the ISO velocity within 0.5 % of the g record's (the
+    integration's 2 Hz high-pass and the record's ends are the only difference), flag unit_converted."""
+    rec = cwru(shared_data, "IR")
+    ref = vm.diagnose(rec, bearing="6205-2RS")
+    x = rec
+    for _ in range(integrations):
+        x = vm.integrate(x)
+    x = x.to_unit(unit)
+    d = vm.diagnose(x, bearing="6205-2RS")
+    assert d.top == ref.top == "bearing_inner_race" and d.confidence > 0.9
+    assert "unit_converted" in d.flags and "unit_unknown" not in d.flags
+    assert d.severity["velocity_rms_mm_s"] == pytest.approx(ref.severity["velocity_rms_mm_s"], rel=0.005)
+    assert f"(in {unit}) differentiated {'once' if integrations == 1 else 'twice'}" in d.reason
+    assert ("ISO 20816" in d.reason) == (integrations == 2)
+
+
+def test_a_velocity_tone_gives_its_own_iso_velocity():
+    """Oracle: a velocity sine of amplitude 3 mm/s at 1X (30 Hz) has an RMS of 3/sqrt(2) = 2.121 mm/s, the
+    ISO 10816-3 velocity (10-1000 Hz; zone B of group 2, rigid: 1.4-2.8 mm/s); read in mm/s it is
+    differentiated to acceleration and divided back: within 0.5 % (the record's ends, continued by
+    prediction)."""
+    fs, f1 = 5000.0, 30.0
+    t = np.arange(int(4 * fs)) / fs
+    v = 3.0 * np.sin(2 * np.pi * f1 * t) + 0.01 * np.random.default_rng(0).standard_normal(t.size)
+    d = vm.diagnose(vm.Record.from_array(v, fs=fs, unit="mm/s"), rpm=60 * f1)
+    assert d.severity["velocity_rms_mm_s"] == pytest.approx(3.0 / np.sqrt(2), rel=0.005)
+    assert d.severity["zone"] == "B"

@@ -10,6 +10,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 import numpy as np
+import scipy.fft as _fft
 from scipy import signal as _sig
 
 from ..core import units as _units
@@ -368,39 +369,50 @@ def _calculus(rec, direction, method, highpass, channels, fs):
     if rec.n_samples < 16:
         raise ParameterError(f"the record has {rec.n_samples} samples; {'integration' if direction > 0 else 'differentiation'} "
                              "needs at least 16 (the high-pass and the extension past the ends need a few cycles)")
-    import scipy.fft as _fft
     data = np.array(rec.data)
     chans = list(rec.channels)
     n = rec.n_samples
-    L = _extension_length(n, rec.fs, hp) if direction > 0 else 0
+    # both ways the record is continued past its ends: the transform's wrap-around (a jump between the
+    # last and first sample) would otherwise ring through the derivative as a sinc at both ends
+    L = _extension_length(n, rec.fs, hp)
     for i in idx:
         x, c = _si(rec, i)
         q_new = _units.integral_quantity(c.quantity) if direction > 0 else _units.derivative_quantity(c.quantity)
-        if direction > 0:   # the offset first (integrated, it is a ramp); then the record continued past its ends
-            x = extend(x - x.mean(), L)
-        if method == "frequency":
-            N = _fft.next_fast_len(x.size, real=True) if direction > 0 else x.size
-            f = np.fft.rfftfreq(N, 1 / rec.fs)
-            X = _fft.rfft(x, N)
-            jw = 2j * np.pi * f
-            if direction > 0:
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    Y = np.where(f >= max(hp, f[1] if f.size > 1 else 0.0), X / jw, 0.0)
-            else:
-                Y = X * jw
-            y = _fft.irfft(Y, N)[L:L + n]
-        elif direction > 0:
-            from scipy.integrate import cumulative_trapezoid
-            sos = _sig.butter(4, hp, btype="highpass", fs=rec.fs, output="sos") if hp > 0 else None
-            xx = _sig.sosfiltfilt(sos, x) if sos is not None else x
-            y = _sig.detrend(cumulative_trapezoid(xx, dx=1 / rec.fs, initial=0.0), type="linear")
-            if sos is not None:  # what the integration made of the residual low-frequency content
-                y = _sig.sosfiltfilt(sos, y)
-            y = y[L:L + n]
-        else:
-            y = np.gradient(x, 1 / rec.fs)
+        if direction < 0:
+            y = derivative(x, rec.fs, 1, extension=L) if method == "frequency" else np.gradient(x, 1 / rec.fs)
+        else:   # the offset first (integrated, it is a ramp); then the record continued past its ends
+            y = _integral(extend(x - x.mean(), L), rec.fs, hp, method)[L:L + n]
         data[i] = y
         chans[i] = Channel(c.name, q_new, _units.SI_UNIT[q_new], c.location)
     verb = "integrate" if direction > 0 else "differentiate"
     note = f"{verb}(method={method!r}" + (f", highpass={hp:g} Hz)" if direction > 0 else ")")
     return rec.replace(data=data, channels=tuple(chans), note=note)
+
+
+def _integral(x: np.ndarray, fs: float, hp: float, method: str) -> np.ndarray:
+    """The integral of the (extended) samples x, nothing kept below ``hp``: X / (i 2 pi f) over the
+    transform, or the trapezoid rule between zero-phase high-passes."""
+    if method == "frequency":
+        N = _fft.next_fast_len(x.size, real=True)
+        f = np.fft.rfftfreq(N, 1 / fs)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Y = np.where(f >= max(hp, f[1] if f.size > 1 else 0.0), _fft.rfft(x, N) / (2j * np.pi * f), 0.0)
+        return _fft.irfft(Y, N)[:x.size]
+    from scipy.integrate import cumulative_trapezoid
+    sos = _sig.butter(4, hp, btype="highpass", fs=fs, output="sos") if hp > 0 else None
+    xx = _sig.sosfiltfilt(sos, x) if sos is not None else x
+    y = _sig.detrend(cumulative_trapezoid(xx, dx=1 / fs, initial=0.0), type="linear")
+    return _sig.sosfiltfilt(sos, y) if sos is not None else y   # what it made of the residual low frequencies
+
+
+def derivative(x: np.ndarray, fs: float, order: int = 1, *, extension: int | None = None) -> np.ndarray:
+    """The ``order``-th time derivative of the samples x, X(f) (i 2 pi f)^order over the transform of x
+    continued past both ends (``extend``, default a quarter of the record each side): without the
+    continuation the jump between the last and the first sample rings through the derivative."""
+    x = np.asarray(x, float)
+    n = x.size
+    L = n // 4 if extension is None else int(extension)
+    xe = extend(x - x.mean(), L)   # the offset has no derivative; the taper would make one of it
+    N = _fft.next_fast_len(xe.size, real=True)
+    f = np.fft.rfftfreq(N, 1 / fs)
+    return _fft.irfft(_fft.rfft(xe, N) * (2j * np.pi * f) ** order, N)[L:L + n]

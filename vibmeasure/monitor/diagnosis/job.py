@@ -38,27 +38,48 @@ class Job:
     prewhitening: tuple = ("cepstral",)
     mains: tuple = (50.0, 60.0)  # the line frequencies whose lines are electrical (``_at_mains``)
     quality: dict = field(default_factory=dict)   # channel -> damage found in its samples (``_damage``)
+    converted: dict = field(default_factory=dict)  # channel -> the velocity or displacement unit it was read in
 
 
 # --- prepare ---------------------------------------------------------------------------------------
 
 def _accel(rec, i, flags, quality, block):
-    """Channel i as float64, in m/s^2 when its unit is a known acceleration unit, with its isolated
+    """Channel i as float64, in m/s^2 when its unit is known (``_in_acceleration``), with its isolated
     spikes repaired (``signal.quality``); ``quality`` (channel -> findings) collects what the samples
     show of the recording chain's damage: spikes, dropouts, saturation, transients (judged on blocks of
     ``block`` samples: (as recorded, whitened), ``_damage``)."""
     x = clean_signal(rec, i, min_samples=256)
     ch = rec.channels[i]
-    x = _damage(x, rec.fs, ch.name, flags, quality, block)
+    # a velocity or displacement is differentiated first: the damage rules judge an acceleration
+    x = _damage(_in_acceleration(x, rec.fs, ch, flags), rec.fs, ch.name, flags, quality, block)
     if not np.ptp(x) > 0:
         raise ParameterError(f"channel {ch.name!r} is constant once the recording chain's damage is repaired "
                              f"({_quality_note({ch.name: quality[ch.name]})}): there is no vibration to analyse")
-    if ch.unit and ch.quantity == "acceleration":
-        x = _units.convert(x, ch.unit, "m/s^2")
-    elif "unit_unknown" not in flags:
-        flags.append("unit_unknown")
     from ...core._validate import check_range
     check_range(x, what=f"channel {ch.name!r}")
+    return x
+
+
+DIFFERENTIATIONS = {"acceleration": 0, "velocity": 1, "displacement": 2}
+
+
+def _in_acceleration(x, fs, ch, flags):
+    """The samples in m/s^2: an acceleration converted, a velocity or a displacement differentiated once
+    or twice (``signal.preprocess.derivative``, the record continued past its ends) so that the
+    envelope and the ISO velocity both see what the sensor measured (flag ``unit_converted``). Every
+    other unit (volts, none) is analysed as it stands, with the flag ``unit_unknown``: the lines'
+    frequencies stand, their levels do not."""
+    k = DIFFERENTIATIONS.get(ch.quantity) if ch.unit else None
+    if k is None:
+        if "unit_unknown" not in flags:
+            flags.append("unit_unknown")
+        return x
+    x = _units.convert(x, ch.unit, _units.SI_UNIT[ch.quantity])
+    if k:
+        from ...signal.preprocess import derivative
+        x = derivative(x, fs, k)
+        if "unit_converted" not in flags:
+            flags.append("unit_converted")
     return x
 
 
@@ -202,8 +223,10 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
         band = check_band(band, rec.fs)
     whitening = _check_prewhitening(prewhitening)
     mains = (50.0, 60.0) if line_frequency is None else (_check_line_frequency(line_frequency, rec.fs),)
+    converted = {rec.channels[i].name: rec.channels[i].unit for i in chosen
+                 if rec.channels[i].unit and DIFFERENTIATIONS.get(rec.channels[i].quantity, 0)}
     return Job(rec.fs, rpm, rec.channels[idx].name, a, signals, bearing, gear, group, found, band, flags,
-               prewhitening=whitening, mains=mains, quality=quality)
+               prewhitening=whitening, mains=mains, quality=quality, converted=converted)
 
 
 def _check_prewhitening(value) -> tuple:

@@ -14,10 +14,11 @@ import pandas as pd
 
 from ...core._validate import as_record, memory_guard
 from ...core.errors import warn_quality
+from ...core.units import quantity_of
 from ...core.results import Diagnosis
 from .bearings import _narrow_channels, _plot_material, bearing_step
 from .decide import _decide, _unweighed
-from .job import Job, _prepare, _quality_note
+from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note
 from .mains import supply_lines
 from .severity import iso_severity
 from .shaft import gate_rows, gear_rows, shaft_rows
@@ -138,6 +139,20 @@ def _time_base_doubt(speed: dict, severity: dict, conf: float, reason: str) -> t
     return conf, reason
 
 
+def _conversion_note(converted: dict) -> str:
+    """What was made of channels in velocity or displacement units, and the standard's scope."""
+    by_unit: dict = {}
+    for k, u in converted.items():
+        by_unit.setdefault(u, []).append(repr(k))
+    note = "; ".join(f"{', '.join(names)} (in {u}) differentiated "
+                     f"{'once' if DIFFERENTIATIONS[quantity_of(u)] == 1 else 'twice'}" for u, names in by_unit.items())
+    note += " to acceleration for the envelope and the shaft orders"
+    if any(quantity_of(u) == "displacement" for u in converted.values()):
+        note += ("; the ISO 10816-3 zones judge velocity on the bearing housing: a proximity probe's shaft "
+                 "displacement is judged by ISO 20816 / 7919 instead")
+    return note
+
+
 def _tracked_speed(rec, tach, rpm_profile, pulses_per_rev) -> dict | None:
     """The speed a tachometer or an rpm profile measures, or None when neither is given."""
     if tach is None and rpm_profile is None:
@@ -181,6 +196,8 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     if narrow:
         reason += ("; " + ", ".join(f"{k} measures only up to {v:.0f} Hz" for k, v in narrow)
                    + " (above: a filter's stop band): the envelope bands reach down among the shaft harmonics")
+    if job.converted:
+        reason += "; " + _conversion_note(job.converted)
     if job.bearing is None or contradicted:
         job.flags.append("bearing_not_checked")
     extras = {"also": also, "primary": job.primary, "score": score, "confidence_kind": kind,
