@@ -55,9 +55,10 @@ def one(job):
         if edge and prefix:
             continue
         d = vm.diagnose(rec, gear=32, **kw)
+        top = "none" if d.top == "undetermined" else d.top   # both name no fault: the map of "none" is learnt
         if not edge:
-            out.append((prefix + d.top, prefix + d.extras["confidence_kind"], d.extras["score"], d.top == fault))
-        if not prefix and d.top == "none":   # the two parts of a "none", each against its kind of fault
+            out.append((prefix + top, prefix + d.extras["confidence_kind"], d.extras["score"], top == fault))
+        if not prefix and top == "none":   # the two parts of a "none", each against its kind of fault
             parts = d.extras["score_parts"]
             if not edge:
                 out.append((NONE_SHAFT, NONE_SHAFT, parts["shaft"], fault not in SHAFT_FAULTS))

@@ -47,6 +47,17 @@ STRESS = [  # (label, synth.machine keywords, bearing, answers that are acceptab
 ]
 
 
+def named(d) -> str:
+    """The fault an answer names, "none" for both answers that name none ("none", "undetermined")."""
+    return "none" if d.top == "undetermined" else d.top
+
+
+def _p_right(d) -> float:
+    """The probability the answer gives itself of being right: its confidence for a fault, the
+    probability that the machine is healthy for an answer that names none."""
+    return d.p_healthy if named(d) == "none" else d.confidence
+
+
 def confusion(n):
     calls = []  # (confidence, right) of every answer
     for snr in SNRS:
@@ -56,8 +67,9 @@ def confusion(n):
             for seed in range(n):
                 rec = vm.synth.machine(fault=fault, snr_db=snr, seed=1000 * (snr + 100) + seed, duration=6.0)
                 d = vm.diagnose(rec, bearing="6205-2RS", gear=32)
-                counts[fault][SHORT.get(d.top, d.top)] += 1
-                calls.append((d.top, d.confidence, d.top == fault, d.extras["score"]))
+                top = named(d)
+                counts[fault][SHORT.get(top, top)] += 1
+                calls.append((top, _p_right(d), top == fault, d.extras["score"]))
         correct = sum(counts[f][SHORT[f]] for f in FAULTS)
         false_alarms = n - counts["none"]["none"]
         print(f"\nSNR {snr} dB: correct {correct}/{n * len(FAULTS)} ({correct / (n * len(FAULTS)) * 100:.1f} %), "
@@ -105,7 +117,7 @@ def shifted(n):
             for seed in range(n):
                 rec = vm.synth.machine(fault=fault, snr_db=snr, seed=1000 * (snr + 100) + 300 + seed, duration=10.0)
                 d = vm.diagnose(rec, bearing="6205-2RS", gear=32)
-                calls.append((d.top, d.confidence, d.top == fault, d.extras["score"]))
+                calls.append((named(d), _p_right(d), named(d) == fault, d.extras["score"]))
     print(f"\ncalibration under a shift (SNR -5 and 5 dB, 10 s: conditions the map was not learnt on; "
           f"{len(calls)} machines):")
     for label, sel in (("fault calls", [c for c in calls if c[0] != "none"]),
@@ -117,7 +129,7 @@ def shifted(n):
 def stress(n):
     print("\nstress cases (0 dB, 6 s): answers")
     for label, kw, bearing, ok in STRESS:
-        tops = [vm.diagnose(vm.synth.machine(snr_db=0, seed=7000 + s, duration=6.0, **kw), bearing=bearing).top
+        tops = [named(vm.diagnose(vm.synth.machine(snr_db=0, seed=7000 + s, duration=6.0, **kw), bearing=bearing))
                 for s in range(n)]
         good = sum(t in ok for t in tops)
         print(f"  {label:45s} {good}/{n} acceptable ({', '.join(sorted(ok))}); "
@@ -143,7 +155,7 @@ def run_up(n):
             answers["mean rpm only"] = plain
             flagged += "speed_varies" in plain.flags
             for m, d in answers.items():
-                k = 0 if d.top == fault else 1 if d.top == "none" else 2
+                k = 0 if d.top == fault else 1 if named(d) == "none" else 2
                 row[m][k] += 1
                 tally[m][k] += 1
         print(f"  {fault:20s} " + "   ".join(f"{m}: {'/'.join(map(str, v))}" for m, v in row.items()))
@@ -182,7 +194,7 @@ def rigs(n):
                 for seed in range(n):
                     rec = vm.synth.machine(fault=kind, rpm=rpm, fs=fs, duration=dur, snr_db=0, bearing=name,
                                            resonance_hz=res, seed=100 + seed)
-                    top = vm.diagnose(rec, bearing=name).top
+                    top = named(vm.diagnose(rec, bearing=name))
                     k = 0 if top == kind else 1 if top == "none" else 2
                     tally[kind][k] += 1
                     if k == 2:
@@ -210,8 +222,8 @@ def cage_combs(n):
             for fault, share in cases:
                 base = vm.synth.machine(fault=fault, rpm=rpm, fs=fs, duration=6.0, snr_db=0, bearing=name, seed=seed)
                 x = base.data[0] + share * np.std(base.data[0]) * comb
-                top = vm.diagnose(vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="g"), rpm=rpm,
-                                  bearing=name).top
+                top = named(vm.diagnose(vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="g"),
+                                        rpm=rpm, bearing=name))
                 k = 0 if top == fault else 1 if top == "none" else 2
                 tally[(fault, share)][k] += 1
                 if k == 2:
@@ -242,7 +254,7 @@ def other_bearing(n):
             for seed in range(n):
                 for snr in (0, 10):
                     rec = vm.synth.machine(fault=fault, bearing=true_b, snr_db=snr, seed=500 + seed, duration=6.0)
-                    top = vm.diagnose(rec, bearing=declared).top
+                    top = named(vm.diagnose(rec, bearing=declared))
                     recs += 1
                     right += vm.diagnose(rec, bearing=true_b).top == fault
                     if top != "none":

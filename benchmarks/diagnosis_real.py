@@ -45,8 +45,9 @@ SHORT = {"bearing_outer_race": "outer", "bearing_inner_race": "inner", "bearing_
 
 def scored(top: str) -> str:
     """The class an answer scores as: a bearing family, "none", or "other" (a shaft-order or gear fault
-    named on a record whose seeded fault is a bearing's: a wrong fault named, counted with the wrong)."""
-    return top if top in CLASSES else "other"
+    named on a record whose seeded fault is a bearing's: a wrong fault named, counted with the wrong);
+    "undetermined" (no fault named, a fault the more likely) scores as "none": nothing wrong is named."""
+    return "none" if top == "undetermined" else top if top in CLASSES else "other"
 MFPT_BEARING = vm.BEARINGS["MFPT"]
 
 
@@ -160,7 +161,7 @@ def main(fault_channel_only=False, upsample=1):
         comb = bpfo_comb_db(rec, rpm, bearing, channel) if truth == "bearing_outer_race" else None
         rows.append({"set": dset, "name": name, "truth": truth, "vm": top, "raw_top": d.top, "ref": ref, "t": dt,
                      "bpfo_db": comb,
-                     "t_ref": dt_ref, "conf": d.confidence, "reason": d.reason, "channel": d.channel,
+                     "t_ref": dt_ref, "conf": d.confidence if top != "none" else d.p_healthy, "reason": d.reason, "channel": d.channel,
                      "n_ch": rec.n_channels})
         print(f"  {dset:8s} {name:28s} truth {SHORT[truth]:5s}  vibmeasure {SHORT[top]:5s} ({d.confidence:.2f}, "
               f"{d.channel})  reference {SHORT[ref]:5s}  {dt:.2f} s", flush=True)
@@ -182,13 +183,14 @@ def main(fault_channel_only=False, upsample=1):
     # the confidence map was learnt on synthetic machines: how it reads on real ones (every record)
     print("\nconfidence on real records (all 57; the map was learnt on synthetic machines):")
     print(f"    {'answer':>8} {'confidence':>12} {'answers':>8} {'right':>8} {'mean':>8}")
-    for kind, sel in (("fault", [r for r in rows if r["raw_top"] != "none"]),
-                      ("none", [r for r in rows if r["raw_top"] == "none"])):
+    # a fault named is right with its confidence; an answer naming none is right (healthy) with p_healthy
+    for kind, sel in (("fault", [r for r in rows if r["vm"] != "none"]),
+                      ("none", [r for r in rows if r["vm"] == "none"])):
         for lo, hi in ((0.0, 0.5), (0.5, 0.9), (0.9, 0.99), (0.99, 1.01)):
             b = [r for r in sel if lo <= r["conf"] < hi]
             if b:
                 print(f"    {kind:>8} {lo:>5.2f}-{min(hi, 1):<5.2f} {len(b):>8} "
-                      f"{np.mean([r['raw_top'] == r['truth'] for r in b]):>8.2f} {np.mean([r['conf'] for r in b]):>8.2f}")
+                      f"{np.mean([r['vm'] == r['truth'] for r in b]):>8.2f} {np.mean([r['conf'] for r in b]):>8.2f}")
     print("\n=== cwru drive-end records ===")
     show("vm.diagnose", [r for r in rows if r["set"] == "cwru"], "vm")
     show("reference", [r for r in rows if r["set"] == "cwru"], "ref")

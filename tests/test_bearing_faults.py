@@ -13,6 +13,7 @@ from types import SimpleNamespace
 
 from vibmeasure.monitor.bearing import cage, decoys, evidence, families, lines, rules, smeared, spectra
 
+NOT_NAMED = ("none", "undetermined")   # no fault named: healthy, or a fault this test cannot name
 STEPS = (rules, spectra, lines, cage, families, decoys, smeared, evidence)
 # the bearing test's steps, each from the module that holds it (unit tests of the statistics below)
 bf = SimpleNamespace(**{k: v for m in STEPS for k, v in vars(m).items() if not k.startswith("__")})
@@ -326,7 +327,7 @@ def test_a_comb_of_even_harmonics_only_is_twice_the_fundamental_and_not_that_fau
                                    duration=6.0)
             assert vm.diagnose(rec, bearing="ZA-2115").top == "bearing_outer_race"
             d = vm.diagnose(rec, bearing="6205-2RS")
-            assert d.top == "none", d.reason
+            assert d.top in NOT_NAMED, d.reason
             row = d.faults.set_index("fault").loc["bearing_outer_race"]
             # the evidence is strong (it would pass every other rule) ...
             assert row.p_value < 1e-6
@@ -364,7 +365,7 @@ def test_a_lone_third_harmonic_with_its_sidebands_is_no_comb_of_that_fault():
                                    duration=6.0)
             assert vm.diagnose(rec, bearing=odd).top == "bearing_inner_race"
             d = vm.diagnose(rec, bearing="6205-2RS")
-            assert d.top == "none", d.reason
+            assert d.top in NOT_NAMED, d.reason
             row = d.faults.set_index("fault").loc["bearing_inner_race"]
             assert row.p_value < 1e-10   # strong, and it would pass every other rule
             standing = {h["harmonic"] for h in row.harmonics if h["db"] >= 10 * np.log10(bf.R_LINE)}
@@ -381,7 +382,7 @@ def test_a_real_outer_race_read_with_the_other_ends_bearing_is_not_its_inner_rac
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", vm.QualityWarning)
         d = vm.diagnose(rec, bearing="6205-2RS")
-    assert d.top == "none", d.reason
+    assert d.top in NOT_NAMED, d.reason
     row = d.faults.set_index("fault").loc["bearing_inner_race"]
     assert row.p_value < 1e-20
     standing = [h for h in row.harmonics if h["db"] >= 10 * np.log10(bf.R_LINE)]
@@ -426,7 +427,7 @@ def test_development_set_scores(development_set):
     # overwhelming evidence in one, MIN_VOTES); the test guards the targets (>= 40 right, <= 2
     # wrong), every inner race, and the level reached
     right = sum(d.top == t for t, d in development_set.values())
-    wrong = sum(d.top != t and d.top != "none" for t, d in development_set.values())
+    wrong = sum(d.top != t and d.top not in NOT_NAMED for t, d in development_set.values())
     assert len(development_set) == 53
     assert wrong <= 1 and right >= 42
     assert all(d.top == t for t, d in development_set.values() if t == "bearing_inner_race")
@@ -440,7 +441,7 @@ def test_a_comb_in_one_view_of_a_real_record_is_not_called(development_set, shar
     # one infogram band (p = 2.3e-4)
     truth, d = development_set["B021_3.mat"]
     row = d.faults.set_index("fault").loc["bearing_outer_race"]
-    assert truth == "bearing_ball" and d.top == "none"
+    assert truth == "bearing_ball" and d.top in NOT_NAMED
     assert row.votes == 1 and bf.SINGLE_VIEW_P < row.p_value < bf.ALPHA
     assert "one view of the record only (1 of the 9 spectra" in row.not_called
     rec = vm.read(shared_data("cwru_fe/OR007@12_2.mat"), fs=12000, unit="g")
@@ -448,7 +449,7 @@ def test_a_comb_in_one_view_of_a_real_record_is_not_called(development_set, shar
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", vm.QualityWarning)
         d4 = vm.diagnose(first, bearing="6203-2RS", channel="X306_FE_time", rpm=rec.meta["rpm"])
-    assert d4.top == "none"
+    assert d4.top in NOT_NAMED
     assert d4.faults.set_index("fault").loc["bearing_inner_race"].votes == 1
 
 
@@ -492,7 +493,7 @@ def test_a_none_names_why_its_strongest_candidate_was_not_called(development_set
     # ball from its smeared comb.)
     truth, d = development_set["B021_0.mat"]
     ball = d.faults.set_index("fault").loc["bearing_ball"]
-    assert truth == "bearing_ball" and d.top == "none"
+    assert truth == "bearing_ball" and d.top in NOT_NAMED
     assert 1e-3 <= ball.p_value < 0.05
     assert f"p = {ball.p_value:.3g} is not below 0.001" in ball.not_called
     assert "1 line(s) stand 7.8 dB above the floor, 2 needed" in ball.not_called
@@ -580,7 +581,7 @@ def test_a_strong_tone_does_not_make_a_bearing_call(shared_data, monkeypatch):
         assert vm.diagnose(noisy, **kw).top == "none"
         set_rule(monkeypatch, "TAPER", 0.0)
         d = vm.diagnose(noisy, **kw)
-        assert d.top == "none"   # the false comb shows in one spectrum only (MIN_VOTES)
+        assert d.top in NOT_NAMED   # the false comb shows in one spectrum only (MIN_VOTES)
         assert "one view of the record only" in d.faults.set_index("fault").loc["bearing_inner_race"].not_called
         set_rule(monkeypatch, "MIN_VOTES", 1)
         assert vm.diagnose(noisy, **kw).top == "bearing_inner_race"

@@ -287,10 +287,11 @@ def _dropped(rec, seed=5):
 
 
 @pytest.mark.parametrize("name, truth", [("B014_3", "bearing_ball"), ("OR007@3_3", "bearing_outer_race"),
-                                         ("B021_3", "none")])
+                                         ("B021_3", "undetermined")])
 def test_dropouts_are_filled_before_the_envelope_analysis(shared_data, name, truth):
     """A dropout is lost data, and the runs of zeros gate the envelope: left as zeros, B014_3 (ball)
-    and OR007@3_3 (outer race) lost their right calls and B021_3 (ball, "none" as recorded) was called
+    and OR007@3_3 (outer race) lost their right calls and B021_3 (ball, named by no family as recorded:
+    "undetermined") was called
     outer race. Filled by the AR interpolation (``quality.fill``), each keeps its answer as recorded;
     the dropouts are still flagged and counted."""
     rec = vm.read(shared_data(f"cwru_fe/{name}.mat"), fs=12000, unit="g")

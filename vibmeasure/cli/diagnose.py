@@ -90,12 +90,14 @@ def _bearing(args):
 def _print_text(args, rec, diag, out) -> None:
     """The answer, its reason, the speed, the severity and one line per fault family."""
     sev = diag.severity
-    where = f" in {diag.channel}" if diag.top != "none" else ""
+    where = f" in {diag.channel}" if diag.top not in ("none", "undetermined") else ""
     contradicted = "speed_contradicted" in diag.flags
     scope = ("; NO FAULT CHECKED: the declared speed is contradicted (give the measured --rpm or --tach)"
              if contradicted else
              " among the shaft-order faults; bearing faults NOT CHECKED" if not diag.bearing_checked else "")
-    print(f"{args.file}: {diag.top.upper()} (confidence {diag.confidence:.2f}){where}{scope}", file=out)
+    healthy = (f", healthy with probability {diag.p_healthy:.2f}"
+               if diag.top == "undetermined" and diag.p_healthy is not None else "")
+    print(f"{args.file}: {diag.top.upper()} (confidence {diag.confidence:.2f}{healthy}){where}{scope}", file=out)
     print(f"  {diag.reason}", file=out)
     if not diag.bearing_checked and not contradicted:
         print("  bearing faults: not checked (give --bearing or --bearing-geometry)", file=out)

@@ -131,8 +131,8 @@ def diagnosis_section(rec, diag, name):
     sev = diag.severity or {}
     # a "none" that is probably wrong (an unexplained candidate, a weak fault it could not name) is
     # worth a look, not a green light
-    if diag.top == "none":
-        cls = "ok" if diag.confidence >= 0.5 else "watch"
+    if diag.top in ("none", "undetermined"):
+        cls = "ok" if diag.top == "none" and diag.confidence >= 0.5 else "watch"
     else:
         cls = "alarm" if diag.confidence >= 0.9 else "watch"
     sec = {"kind": "diagnosis", "title": f"Machine diagnosis: {name}", "tables": [], "figures": [],

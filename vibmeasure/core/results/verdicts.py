@@ -14,11 +14,14 @@ class Diagnosis:
     Attributes
     ----------
     top : str
-        The answer: none, unbalance, misalignment, looseness, bearing_outer_race, bearing_inner_race,
-        bearing_ball, gear_mesh, resonance or electrical.
+        The answer: a fault (unbalance, misalignment, looseness, bearing_outer_race, bearing_inner_race,
+        bearing_ball, gear_mesh, resonance or electrical); "none" where no fault is named and the
+        machine is healthy with a probability of 0.5 or more; "undetermined" where no fault is named
+        yet a fault is the more likely (``extras["candidates"]`` lists the strongest families).
     confidence : float
         The probability that ``top`` is right, calibrated on synthetic machines
         (monitor/calibration.py); ``extras["score"]`` is the raw evidence score it was mapped from.
+        For "undetermined" it is 1 - ``p_healthy``: the probability that some fault is present.
     reason : str
         Why, in words: the evidence, the strongest candidate of a "none", what was not checked.
     faults : pandas.DataFrame
@@ -38,6 +41,9 @@ class Diagnosis:
         The channel that carries the top's evidence.
     bearing_checked : bool
         False without a bearing, or where the declared speed is contradicted.
+    p_healthy : float or None
+        The probability that the machine carries none of the faults checked (None for a diagnosis
+        made before this field existed).
 
     Raises
     ------
@@ -64,6 +70,7 @@ class Diagnosis:
     extras: dict = field(default_factory=dict)
     channel: str = ""
     bearing_checked: bool = False
+    p_healthy: float | None = None
 
     def to_dict(self) -> dict:
         """The diagnosis as plain JSON-ready values (the CLI's ``--json`` document).
@@ -71,8 +78,8 @@ class Diagnosis:
         Returns
         -------
         dict
-            top, confidence, score, reason, channel, bearing_checked, faults (records), speed, severity,
-            envelope_band_hz, flags, also, measured_top_hz.
+            top, confidence, p_healthy, score, reason, channel, bearing_checked, faults (records), speed,
+            severity, envelope_band_hz, flags, also, candidates, measured_top_hz.
 
         Raises
         ------
@@ -87,7 +94,8 @@ class Diagnosis:
         >>> d.to_dict()["top"]
         'unbalance'
         """
-        return jsonable({"top": self.top, "confidence": self.confidence, "score": self.extras.get("score"),
+        return jsonable({"top": self.top, "confidence": self.confidence, "p_healthy": self.p_healthy,
+                         "score": self.extras.get("score"), "candidates": self.extras.get("candidates", []),
                          "reason": self.reason,
                          "channel": self.channel, "bearing_checked": self.bearing_checked,
                          "faults": self.faults.to_dict(orient="records"), "speed": self.speed,

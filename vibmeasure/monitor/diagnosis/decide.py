@@ -45,7 +45,16 @@ def _unweighed(rows) -> tuple | None:
 
 def _decide(table, job: Job, weak: bool):
     """The top fault: the most confident shaft-order or bearing fault at TOP_CONFIDENCE or more and not
-    tied with another of its own kind; else "none" with the reason and the strongest candidate."""
+    tied with another of its own kind; else "none" when the machine is healthy with a probability of
+    TOP_CONFIDENCE or more, and "undetermined" (probably a fault that cannot be named) below it, both
+    with the reason and the strongest candidates. The last item returned is the probability that the
+    machine is healthy (``p_healthy``)."""
+    s_shaft, s_bear = _p_none(table)
+    if job.bearing is not None and not weak:
+        # each part mapped to the chance that no fault of its kind was missed
+        p_healthy = calibrated(NONE_SHAFT, s_shaft, NONE_SHAFT) * calibrated(NONE_BEARING, s_bear, NONE_BEARING)
+    else:   # no bearing, or no channel with a band to demodulate: the bearing side says little
+        p_healthy = calibrated(UNCHECKED + "none", s_shaft * s_bear, UNCHECKED + "none")
     ranked = table.assign(_bearing=table.fault.isin(list(FAMILIES)))
     # a bearing family that passed its test outranks shaft-order scores: it is the specific finding
     ranked = ranked.sort_values(["_bearing", "confidence"], ascending=False)
@@ -69,7 +78,9 @@ def _decide(table, job: Job, weak: bool):
             if also:
                 reason += f"; also scored above {TOP_CONFIDENCE}: {', '.join(also)}"
             channel = best.get("channel") if top in FAMILIES else job.primary
-            return top, conf, reason + checked, also, channel or job.primary, (kind, score, None)
+            # the fault called and a healthy machine exclude each other
+            return (top, conf, reason + checked, also, channel or job.primary, (kind, score, None),
+                    min(p_healthy, 1.0 - conf))
         why = f"{best.fault} and {kin[0].fault} are equally likely"
     elif "speed_contradicted" in job.flags:
         why = "the declared speed is contradicted"
@@ -84,18 +95,33 @@ def _decide(table, job: Job, weak: bool):
         if isinstance(b.get("not_called"), str):
             strongest += f" (not called: {b.not_called})"
     strongest += _cage_standing(table)
-    s_shaft, s_bear = _p_none(table)
     p_none = s_shaft * s_bear
     top_score = (f"strongest candidate {cand.fault} at score {cand.confidence:.2f}" if cand.confidence >= 0.005
                  else "every family scored 0.00")
-    reason = (f"none: {why}{checked}" if "speed_contradicted" in job.flags else
-              f"none: {why}; {top_score}{strongest}{checked}")
-    if job.bearing is not None and not weak:
-        # each part mapped to the chance that no fault of its kind was missed
-        conf = calibrated(NONE_SHAFT, s_shaft, NONE_SHAFT) * calibrated(NONE_BEARING, s_bear, NONE_BEARING)
-    else:   # no bearing, or no channel with a band to demodulate: the bearing side says little
-        conf = calibrated(UNCHECKED + "none", p_none, UNCHECKED + "none")
-    return "none", conf, reason, [], job.primary, ("none", p_none, {"shaft": s_shaft, "bearing": s_bear})
+    # "none" only where the machine is more likely healthy than not: below, "none, confidence 0.1" would
+    # read "no fault, barely sure" where it means "probably a fault this test cannot name"
+    top = "none" if p_healthy >= TOP_CONFIDENCE else "undetermined"
+    conf = p_healthy if top == "none" else 1.0 - p_healthy
+    said = (f"none: healthy with probability {p_healthy:.2f}" if top == "none" else
+            f"undetermined: no fault named, yet the machine is healthy with probability only {p_healthy:.2f}")
+    reason = (f"{said}; {why}{checked}" if "speed_contradicted" in job.flags else
+              f"{said}; {why}; {top_score}{strongest}{checked}")
+    return (top, conf, reason, [], job.primary, ("none", p_none, {"shaft": s_shaft, "bearing": s_bear}),
+            p_healthy)
+
+
+def candidates(table, n: int = 3) -> list[dict]:
+    """The ``n`` strongest fault families of an answer that names none: shaft-order families by their
+    score, bearing families by their p-value (the cage left out: it is reported, never called)."""
+    rows = table[table.fault != "bearing_cage"]
+    out = []
+    for _, r in rows.iterrows():
+        p = r.get("p_value") if r.fault in FAMILIES else None
+        weight = float(r.confidence) if p is None or p != p else max(float(r.confidence), 1.0 - float(p))
+        out.append({"fault": str(r.fault), "score": float(r.confidence),
+                    "p_value": None if p is None or p != p else float(p), "_w": weight})
+    out.sort(key=lambda c: -c["_w"])
+    return [{k: v for k, v in c.items() if k != "_w"} for c in out[:n] if c["_w"] > 0.005]
 
 
 def _cage_standing(table) -> str:

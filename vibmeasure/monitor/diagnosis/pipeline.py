@@ -17,7 +17,7 @@ from ...core.errors import warn_quality
 from ...core.units import quantity_of
 from ...core.results import Diagnosis
 from .bearings import _narrow_channels, _plot_material, bearing_step
-from .decide import _decide, _unweighed
+from .decide import _decide, _unweighed, candidates
 from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note
 from .mains import supply_lines
 from .severity import iso_severity
@@ -168,8 +168,9 @@ def _tach_channel(rec, tach) -> tuple:
 
 
 def _bearing_weak(job: Job, ev, narrow: list, contradicted: bool) -> bool:
-    """Whether the bearing side says little about "none": the speed varies unfollowed, every channel's
-    measured band ends below the demodulation region, or the declared speed is contradicted."""
+    """Whether the bearing side says little about "none": the speed varies (followed, if at all, along
+    a speed estimated from the 1X, not measured), every channel's measured band ends below the
+    demodulation region, or the declared speed is contradicted."""
     weak = "speed_varies" in job.flags
     if narrow:
         weak = len(narrow) == len(ev.measured_top_hz)
@@ -184,8 +185,9 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     weak = _bearing_weak(job, ev, narrow, contradicted)
     unweighed = _unweighed(rows) if "unit_unknown" in job.flags else None
     table = pd.DataFrame(rows).sort_values("confidence", ascending=False, ignore_index=True)
-    top, conf, reason, also, where, (kind, score, parts) = _decide(table, job, weak)
+    top, conf, reason, also, where, (kind, score, parts), p_healthy = _decide(table, job, weak)
     conf, reason = _time_base_doubt(speed, severity, conf, reason)
+    p_healthy = min(p_healthy, conf) if top == "none" else p_healthy
     if unweighed:
         reason += (f"; shaft-order faults not called: the data's unit is unknown, so the ISO 10816-3 level that "
                    f"shows whether they matter cannot be computed (give unit=, e.g. 'g'); strongest pattern "
@@ -201,7 +203,9 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     if job.bearing is None or contradicted:
         job.flags.append("bearing_not_checked")
     extras = {"also": also, "primary": job.primary, "score": score, "confidence_kind": kind,
-              "channels_used": list(job.signals)}
+              "channels_used": list(job.signals), "p_healthy": float(p_healthy)}
+    if top == "undetermined":
+        extras["candidates"] = candidates(table)
     if job.quality:
         note = _quality_note(job.quality)
         reason += "; data: " + note
@@ -215,4 +219,5 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
         extras["measured_top_hz"] = dict(ev.measured_top_hz)
         env_band = extras["ses"]["band_hz"]
     return Diagnosis(top, conf, reason, table, speed, severity, tuple(env_band), tuple(job.flags), extras,
-                     channel=str(where), bearing_checked=job.bearing is not None and not contradicted)
+                     channel=str(where), bearing_checked=job.bearing is not None and not contradicted,
+                     p_healthy=float(p_healthy))
