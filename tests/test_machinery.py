@@ -899,3 +899,23 @@ def test_a_velocity_tone_gives_its_own_iso_velocity():
     d = vm.diagnose(vm.Record.from_array(v, fs=fs, unit="mm/s"), rpm=60 * f1)
     assert d.severity["velocity_rms_mm_s"] == pytest.approx(3.0 / np.sqrt(2), rel=0.005)
     assert d.severity["zone"] == "B"
+
+
+def test_the_speed_an_mfpt_file_states_is_read(shared_data, tmp_path):
+    """MFPT files state the shaft rate in Hz as bearing.rate beside the sampling rate bearing.sr: read as
+    rpm (25 Hz -> 1500 rpm), so diagnose needs no rpm= for them, as for CWRU's XNNNRPM. A bare "rate"
+    anywhere else (no sampling rate beside it) is no speed, and a speed that is no positive number is
+    ignored."""
+    import scipy.io as sio
+    path = shared_data("mfpt/InnerRaceFault_vload_2.mat")
+    rec = vm.read(path)
+    assert rec.meta["rpm"] == 1500.0 and rec.meta["rpm_source"] == "variable 'bearing.rate'"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        assert vm.diagnose(rec, bearing="MFPT").top == "bearing_inner_race"
+    x = np.sin(np.arange(4000) / 7.0)
+    sio.savemat(tmp_path / "a.mat", {"s": {"data": x, "rate": 25.0}, "fs": 1000.0})
+    sio.savemat(tmp_path / "b.mat", {"s": {"data": x, "rate": -3.0, "sr": 1000.0}})
+    sio.savemat(tmp_path / "c.mat", {"s": {"data": x, "shaft_rate": 30.0}, "fs": 1000.0})
+    assert "rpm" not in vm.read(tmp_path / "a.mat").meta and "rpm" not in vm.read(tmp_path / "b.mat").meta
+    assert vm.read(tmp_path / "c.mat").meta["rpm"] == 1800.0

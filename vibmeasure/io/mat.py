@@ -21,6 +21,9 @@ from ._common import DEFAULT_MAX_SAMPLES, check_size, fs_from_time, make_record,
 _TIME_LEAF = re.compile(r"^(time|t|time_domain|timevector|tvec|time_s)$", re.I)
 _FS_LEAF = re.compile(r"^(fs|sr|samplerate|sample_rate|sampling_rate|samplingrate|.*_sample_rate|fsamp)$", re.I)
 _RPM_LEAF = re.compile(r".*rpm$", re.I)
+# a shaft speed in Hz: named so, or a bare "rate" beside the struct's sampling rate (MFPT's bearing.rate
+# beside bearing.sr): there "rate" cannot be the sampling rate, which is stated
+_SHAFT_HZ_LEAF = re.compile(r"^(shaft_?rate|shaft_?hz|shaft_?speed_?hz|shaft_?frequency)$", re.I)
 
 
 def _leaves_v5(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
@@ -251,7 +254,30 @@ def read_mat(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
             raise ParameterError(f"fs={fs:g} contradicts {src}, whose timing gives {file_fs:g} Hz")
     fs = file_fs if file_fs is not None else require_fs(fs, source=src)
     meta = {"source": str(path)}
-    for k, v in scalars.items():
-        if _RPM_LEAF.match(k.split(".")[-1]):
-            meta["rpm"] = float(np.asarray(v).ravel()[0])
+    meta.update(_stated_speed(scalars, stated, src))
     return make_record(data, fs, names, quantity=quantity, unit=unit, t0=t0, meta=meta, source=src)
+
+
+def _stated_speed(scalars: dict, stated_fs: dict, src: str) -> dict:
+    """The shaft speed the file states: a variable ending in "rpm", or a shaft rate in Hz (a leaf named
+    so, or a bare "rate" in the struct that states the sampling rate) turned to rpm; with the variable it
+    came from (``rpm_source``). A value that is no positive number is ignored, never guessed."""
+    fs_structs = {k.rsplit(".", 1)[0] for k in stated_fs if "." in k}
+    found = []
+    for k, v in scalars.items():
+        leaf = k.split(".")[-1]
+        factor = 1.0 if _RPM_LEAF.match(leaf) else 60.0 if (
+            _SHAFT_HZ_LEAF.match(leaf) or (leaf.lower() == "rate" and "." in k and k.rsplit(".", 1)[0] in fs_structs)
+        ) else None
+        if factor is None:
+            continue
+        try:
+            value = float(np.asarray(v, dtype=float).ravel()[0]) * factor
+        except (TypeError, ValueError, IndexError):
+            continue
+        if np.isfinite(value) and value > 0:
+            found.append((factor == 1.0, k, value))
+    if not found:
+        return {}
+    _, key, rpm = max(found, key=lambda f: f[0])   # an rpm stated as such first
+    return {"rpm": rpm, "rpm_source": f"variable {key!r}"}
