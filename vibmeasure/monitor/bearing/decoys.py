@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from .families import _family
-from .lines import _best, _comb, _positions, _step
+from .families import HALVES
+from .lines import _best, _comb, _halves, _positions, _step
 from .rules import ALPHA, FAMILIES, SLIP
 from .spectra import _SES
 
@@ -61,6 +62,15 @@ def _decoy_p(ses: _SES, res: dict, f0: float, freqs: dict) -> float:
 # harmonics read as BSF x 0.5, 1, 1.5 at 0.501 x).
 SPEED_SCAN = (0.5, 2.0)
 SPEED_SCAN_MARGIN = 1e-3
+# A speed off by a factor 2 (rpm read as Hz x 30, two pulses per revolution, a gearbox's other shaft) is
+# the commonest mistake, and a 1X found near it confirms nothing: the true shaft's 2X stands at twice a
+# speed declared half the true one, with its own harmonics, and a line near half the true speed takes
+# the true 1X and its harmonics for its even harmonics. So the bearing's lines are searched within
+# FACTOR_WINDOW of 0.5 and 2 x the declared speed even when a 1X confirms it, by the same rule as the
+# scan (a significant comb SPEED_SCAN_MARGIN below the declared speed's best); the full scan's range
+# ends there and would miss a factor of exactly 2 (a comb at its edge "would fit better outside").
+FACTOR_WINDOW = 0.06
+FACTOR_WINDOWS = tuple((u * (1 - FACTOR_WINDOW), u * (1 + FACTOR_WINDOW)) for u in (0.5, 2.0))
 
 
 def _scan_comb(ses: _SES, f0: float, harmonics, side, lo: float, hi: float, excluded: float = 0.0):
@@ -106,8 +116,9 @@ def _declared(hz: list, freqs: dict, df: float) -> bool:
                                 for f in (freqs["BPFO"], freqs["BPFI"], freqs["BSF"], freqs["2xBSF"])) for h in hz)
 
 
-def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float) -> dict | None:
-    """The bearing comb that contradicts the declared speed (see SPEED_SCAN), or None: {"factor": true
+def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, confirmed: bool = False) -> dict | None:
+    """The bearing comb that contradicts the declared speed (see SPEED_SCAN; where a 1X ``confirmed`` the
+    speed, only within FACTOR_WINDOWS), or None: {"factor": true
     over declared speed, "family", "model", "p_value", "declared_p_value", "lines": [(Hz, dB)], "channel",
     "preprocessing", "other_factors"}. Both sides are judged on the same lines: every spectrum after the
     shaft's and the cage's claims (``r_base``), every family at the declared speed (its +-SLIP, and
@@ -116,44 +127,33 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float) -> d
     bearing's."""
     n_sp = max(1, len(spectra))
     found, declared = [], 0.0
-    lo, hi = SPEED_SCAN[0] - 1.0, SPEED_SCAN[1] - 1.0
+    ranges = FACTOR_WINDOWS if confirmed else (SPEED_SCAN,) + FACTOR_WINDOWS
     for ses in spectra:
         saved, ses.r = ses.r, ses.r_base if ses.r_base is not None else ses.r
         try:
             for name in FAMILIES:
                 res = _family(ses, name, freqs, f1)
-                if res is not None:
+                # a comb with lines halfway between its harmonics speaks for half the speed, not this one
+                if res is not None and res.get("halves", 0) < HALVES:
                     declared = min(declared, res["logp"] + np.log(n_sp))
         finally:
             ses.r = saved
-        df = ses.freq[1]
         for name, (key, models) in FAMILIES.items():
             for harmonics, side in models:
                 sp = None if side is None else (f1 if side == "1X" else freqs["FTF"],)
                 # within the 1X search a comb only says the speed is somewhat off (the declared speed
                 # stands, as with a 1X found there): it counts for the declared speed
                 near = _scan_comb(ses, freqs[key], harmonics, sp, -speed_search, speed_search)
-                if near is not None:
+                if near is not None and _halves(ses, freqs[key] * near[1], harmonics, base=True) < HALVES:
                     declared = min(declared, near[0] + np.log(len(models)) + np.log(n_sp))
-                res = _scan_comb(ses, freqs[key], harmonics, sp, lo, hi, max(SLIP, speed_search))
-                if res is None:
-                    continue
-                logp, u, vals, terms = res
-                logp += np.log(len(models)) + np.log(n_sp)
-                standing = [(h, k) for (h, k), v in zip(terms, vals) if v >= ses.r_line]
-                if (len(standing) < 2 or not any(k == 0 and h <= 3 for h, k in standing)
-                        or _step(h for h, k in standing) > 1.0):
-                    continue
-                spacing = 0.0 if side is None else sp[0] * u
-                lines = [(round(float(h * freqs[key] * u + k * spacing), 2), round(float(10 * np.log10(v)), 1))
-                         for (h, k), v in zip(terms, vals) if v >= ses.r_line]
-                carriers = [h * freqs[key] * u for h, k in standing if k == 0]
-                if _shaft_like([hz for hz, _ in lines], f1, speed_search, df) or _declared(carriers, freqs, df):
-                    continue
-                found.append((logp, dict(
-                    factor=u, family=name, model=f"{key} x {','.join(f'{h:g}' for h in harmonics)}"
-                    + (f" +-{side}" if side else ""), p_value=float(np.exp(logp)), lines=lines,
-                    channel=ses.channel, preprocessing=ses.prep)))
+                for lo, hi in ranges:
+                    res = _scan_comb(ses, freqs[key], harmonics, sp, lo - 1.0, hi - 1.0, max(SLIP, speed_search))
+                    if res is None:
+                        continue
+                    c = _scanned(res, ses, freqs, key, harmonics, side, sp, f1, speed_search,
+                                 np.log(len(models)) + np.log(n_sp), (lo, hi) in FACTOR_WINDOWS)
+                    if c is not None:
+                        found.append((c[0], dict(c[1], family=name)))
     if not found:
         return None
     found.sort(key=lambda c: c[0])
@@ -170,3 +170,29 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float) -> d
             others.append(c["factor"])
     best["other_factors"] = others
     return best
+
+
+def _scanned(res, ses, freqs, key, harmonics, side, sp, f1, speed_search, penalty, factor_window=False):
+    """(log p, comb) of a scanned comb ``res`` (``_scan_comb``) that may contradict the declared speed:
+    at least two lines standing, one a carrier at a first-three harmonic, no gap over one harmonic; not
+    a shaft's comb within the 1X search (``_shaft_like``) nor, outside the ``factor_window`` of 0.5 or 2,
+    carriers all at the declared speed's bearing lines (``_declared``). Near a factor of 2 every line of
+    a comb is a harmonic of a line of the same family at the other speed, so that exclusion would take
+    every comb: there the margin over the declared speed's best comb alone decides (the comb with all its
+    harmonics beats the one that sees every second of them). None otherwise. ``penalty``: log of the
+    models and spectra tried."""
+    logp, u, vals, terms = res
+    logp += penalty
+    standing = [(h, k) for (h, k), v in zip(terms, vals) if v >= ses.r_line]
+    if (len(standing) < 2 or not any(k == 0 and h <= 3 for h, k in standing)
+            or _step(h for h, k in standing) > 1.0 or _halves(ses, freqs[key] * u, harmonics, base=True) >= HALVES):
+        return None
+    spacing = 0.0 if side is None else sp[0] * u
+    lines = [(round(float(h * freqs[key] * u + k * spacing), 2), round(float(10 * np.log10(v)), 1))
+             for (h, k), v in zip(terms, vals) if v >= ses.r_line]
+    carriers = [h * freqs[key] * u for h, k in standing if k == 0]
+    if _shaft_like([hz for hz, _ in lines], f1, speed_search, ses.freq[1]) or (
+            not factor_window and _declared(carriers, freqs, ses.freq[1])):
+        return None
+    return logp, dict(factor=u, model=f"{key} x {','.join(f'{h:g}' for h in harmonics)}" + (f" +-{side}" if side else ""),
+                      p_value=float(np.exp(logp)), lines=lines, channel=ses.channel, preprocessing=ses.prep)

@@ -9,7 +9,7 @@ import numpy as np
 from ...core.errors import ParameterError
 from .cage import _cage_floor
 from .decoys import _decoy_p, _speed_scan
-from .families import _accepted, _claim_artefact, _explain, _shaft_shows
+from .families import HALVES, _accepted, _claim_artefact, _explain, _shaft_shows
 from .lines import _log_p_to_conf
 from .rules import ALPHA, FAMILIES, MIN_VOTES, R_LINE, SAME_DATA, SINGLE_VIEW_P, SLIP
 from .smeared import _call_smeared, _smeared_ball
@@ -74,8 +74,9 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     artefact_hz : tuple of float
         Fundamentals of combs the recording chain made (spikes every P samples: fs / P), claimed first.
     speed_search : float, optional
-        How far (share of f1) the caller looked for the 1X; given, and unless ``speed_confirmed``,
-        the bearing's lines are also searched at other speeds (``decoys._speed_scan``).
+        How far (share of f1) the caller looked for the 1X; given, the bearing's lines are also
+        searched at other speeds (``decoys._speed_scan``: from 0.5 to 2 x f1, or near 0.5 and 2 x
+        alone where ``speed_confirmed``).
     speed_confirmed : bool, optional
         Whether the speed is confirmed (default ``f1_known``).
     smeared_ball : bool
@@ -106,7 +107,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     smeared = _smeared_if_none(fams, spectra, freqs, f1) if smeared_ball else None
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))
     confirmed = f1_known if speed_confirmed is None else speed_confirmed
-    other = None if confirmed or speed_search is None else _speed_scan(spectra, freqs, f1, speed_search)
+    other = None if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed)
     return BearingEvidence(fams, spectra, spectra[0].kurtogram, len(spectra), measured, other)
 
 
@@ -247,6 +248,11 @@ def _not_called(name: str, fam: dict, n_sp: int, n_views: int) -> str | None:
         why.append(f"its lines stand only at multiples of its harmonic {fam['step']:g}: they make a comb at "
                    f"{fam['step']:g} x its fundamental ({fam['step'] * fam['found_hz']:.1f} Hz), which is no "
                    "frequency of this bearing")
+    if fam.get("halves", 0) >= HALVES:
+        why.append(f"lines stand also halfway between its harmonics: with them it is the even part of a comb at "
+                   f"half its fundamental ({fam['found_hz'] / 2:.1f} Hz), no frequency of this bearing at the "
+                   f"declared speed; at half that speed it is this family's own (check the speed for a factor 2: "
+                   f"rpm for Hz, pulses per revolution)")
     if fam.get("edge"):
         why.append(f"its comb fits best at the edge of the +-{100 * SLIP:g} % slip range, so it would fit better "
                    "further off: the lines are not where this bearing puts them (a shaft-order comb, another "
@@ -288,7 +294,7 @@ def _summary(name, key, res, ses, freqs, n_sp) -> dict:
             "statistic": res["stat"], "n_terms": res["n_terms"],
             "log10_p": float(logp / np.log(10)), "slip": res["slip"], "found_hz": float(f0),
             "lines": lines, "n_lines": res["n_lines"], "n_carriers": res["n_carriers"], "edge": res.get("edge", False),
-            "n_odd": res.get("n_odd", 1), "step": res.get("step", 1.0),
+            "n_odd": res.get("n_odd", 1), "step": res.get("step", 1.0), "halves": res.get("halves", 0),
             "channel": ses.channel,
             "preprocessing": ses.prep,
             "band_hz": ses.band, "model": res.get("model"), "modulation_sidebands": res.get("modulation"),

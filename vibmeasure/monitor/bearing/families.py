@@ -134,6 +134,9 @@ def _claim_family(ses: _SES, name: str, res: dict, freqs: dict, f1: float):
         h += 1
 
 
+HALVES = 2   # half-harmonic lines that make a comb the even part of one at half its fundamental
+
+
 def _accepted(res: dict | None) -> bool:
     """Significant, at least two lines, one of them at one of the first three harmonics of the family's
     own fundamental, and (inner race, ball) the modulation sidebands of the fault. (A comb of only its
@@ -162,9 +165,14 @@ def _accepted(res: dict | None) -> bool:
       and +2X sidebands (453, 483, 512 Hz on OR021@3_1) stands as the 6205's 3 x BPFI with its +-1X,
       nothing at its 1st or 2nd harmonic. With it, the 49 CWRU records read with the other end's
       bearing give 11 bearing calls (13 without). On the development records, the synthetic
-      benchmark and the 27 robustness variants no answer changed."""
+      benchmark and the 27 robustness variants no answer changed.
+    - Half-harmonics (``lines._halves``): with lines standing also at 0.5, 1.5 or 2.5 x the
+      fundamental (HALVES of them), the comb is the even part of one at half the fundamental: the
+      speed declared twice too fast puts every line of the true comb at half a harmonic of the
+      declared one. MFPT's outer race declared at 3000 rpm (true 1500) read as outer race at 1.00 from
+      BPFO x 2, 4, 6 ... of the true speed, with the odd ones standing between."""
     return bool(res and res["n_lines"] >= 2 and res["n_carriers"] >= 1 and res["logp"] < np.log(ALPHA)
-                and res.get("step", 1.0) <= 1.0
+                and res.get("step", 1.0) <= 1.0 and res.get("halves", 0) < HALVES
                 and res.get("modulation") != 0 and not res.get("edge"))
 
 

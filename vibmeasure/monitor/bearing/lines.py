@@ -81,7 +81,33 @@ def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
             "lines": lines, "n_lines": int(sum(v >= ses.r_line for v in vals[j])),
             "n_carriers": int(sum(v >= ses.r_line for (h, k), v in zip(terms, vals[j]) if k == 0 and h <= 3)),
             "n_odd": int(sum(v >= ses.r_line for (h, k), v in zip(terms, vals[j]) if h != int(h) or int(h) % 2)),
-            "step": _step(h for (h, k), v in zip(terms, vals[j]) if v >= ses.r_line)}
+            "step": _step(h for (h, k), v in zip(terms, vals[j]) if v >= ses.r_line),
+            "halves": _halves(ses, f0 * (1 + s[j]), harmonics)}
+
+
+HALF_SHARE = 0.5   # a half-harmonic line counts from this share of the comb's own lines' median height
+
+
+def _halves(ses: _SES, f0: float, harmonics, base: bool = False) -> int:
+    """How many of the lines halfway below the comb's first three harmonics (0.5, 1.5, 2.5 x f0) stand
+    as high as the comb's own (HALF_SHARE of the median of its standing harmonics 1-3): two or more make
+    the comb the even harmonics of one at f0 / 2 (the true lines of a speed declared twice too fast, all
+    of one height). Weaker half-lines are no such comb: CWRU IR021_3's inner race shows BPFI / 2 and
+    1.5 x BPFI at a fifth of its own lines' height. 0 for a comb with half-harmonics of its own (the
+    ball's BSF sub-model). ``base``: on the lines left after the shaft's and the cage's claims."""
+    if any(h != int(h) for h in harmonics):
+        return 0
+    df = ses.freq[1]
+    r = ses.r_base if base and ses.r_base is not None else ses.r
+
+    def height(hz):
+        i = int(hz / df)
+        return float(max(r[i - 1: i + 3])) if 1 <= i < ses.n_valid - 2 else 0.0
+    own = [v for v in (height(h * f0) for h in (1, 2, 3)) if v >= ses.r_line]
+    if not own:
+        return 0
+    need = max(ses.r_line, HALF_SHARE * float(np.median(own)))
+    return sum(height((h - 0.5) * f0) >= need for h in (1, 2, 3) if (h - 0.5) * f0 / df >= 2)
 
 
 def _step(harmonics) -> float:

@@ -16,6 +16,8 @@ from ...core._validate import as_record, memory_guard
 from ...core.errors import warn_quality
 from ...core.units import quantity_of
 from ...core.results import Diagnosis
+from ..bearing.families import HALVES
+from ..bearing.rules import ALPHA
 from .bearings import _narrow_channels, _plot_material, bearing_step
 from .decide import _decide, _unweighed, candidates
 from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note
@@ -139,6 +141,29 @@ def _time_base_doubt(speed: dict, severity: dict, conf: float, reason: str) -> t
     return conf, reason
 
 
+def _half_speed_doubt(ev, job: Job, conf: float, reason: str) -> tuple[float, str]:
+    """A bearing family whose significant comb is refused because lines stand halfway between its
+    harmonics (``bearing.families._accepted``, HALVES) is the even part of a comb at half its
+    fundamental: the true speed may be half the declared one. Whatever else the lines make of the
+    declared speed then rests on a doubtful speed (MFPT's outer race declared at twice its speed
+    read as inner race at 1.00 from BPFO x 3, 6, 9 at +1.2 % slip): flag ``speed_doubtful`` and hold the
+    confidence under DOUBT_CONFIDENCE."""
+    if ev is None:
+        return conf, reason
+    # the cage is left out: its comb is reported, never called, and FTF's half-harmonics are dense
+    halved = [n for n, fam in ev.families.items() if n != "bearing_cage" and fam.get("halves", 0) >= HALVES
+              and fam["log_p"] < np.log(ALPHA)]
+    if not halved:
+        return conf, reason
+    job.flags.append("speed_doubtful")
+    reason += (f"; {', '.join(halved)}: lines stand halfway between its harmonics, a comb at half its fundamental: "
+               f"the speed may be half the declared {job.rpm:g} rpm (rpm for Hz, pulses per revolution)")
+    if conf > DOUBT_CONFIDENCE:
+        reason += f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f}): check the speed"
+        conf = DOUBT_CONFIDENCE
+    return conf, reason
+
+
 def _conversion_note(converted: dict) -> str:
     """What was made of channels in velocity or displacement units, and the standard's scope."""
     by_unit: dict = {}
@@ -187,6 +212,7 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     table = pd.DataFrame(rows).sort_values("confidence", ascending=False, ignore_index=True)
     top, conf, reason, also, where, (kind, score, parts), p_healthy = _decide(table, job, weak)
     conf, reason = _time_base_doubt(speed, severity, conf, reason)
+    conf, reason = _half_speed_doubt(ev, job, conf, reason)
     p_healthy = min(p_healthy, conf) if top == "none" else p_healthy
     if unweighed:
         reason += (f"; shaft-order faults not called: the data's unit is unknown, so the ISO 10816-3 level that "

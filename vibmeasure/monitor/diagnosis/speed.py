@@ -233,6 +233,11 @@ def _bearing_contradiction(job: Job, speed: dict, f1: float, other: dict):
     rpm = 60 * f1 * other["factor"]
     if speed["estimated_rpm"] is None:
         why = "no 1X line confirms it"
+    elif speed.get("source") is not None:
+        why = (f"the {speed['source']} gives {speed['estimated_rpm']:.0f} rpm (check its pulses per revolution)")
+    elif _confirmed(speed):   # a factor of 2 (decoys.FACTOR_WINDOWS): a 1X found says little
+        why = (f"a 1X line stands at {speed['estimated_rpm']:.0f} rpm, but a shaft's 2X stands at twice a speed "
+               "declared half the true one, and a line at half the true speed takes its harmonics for its own")
     else:   # a 1X candidate off the declared speed without its harmonics (ONE_X_CONFIRMS)
         why = (f"the 1X candidate, at {speed['estimated_rpm']:.0f} rpm, shows "
                f"{speed.get('one_x_harmonics', 0)} of its harmonics 2X-6X ({ONE_X_CONFIRMS} confirm a speed)")
