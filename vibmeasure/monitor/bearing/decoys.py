@@ -70,6 +70,8 @@ SPEED_SCAN_MARGIN = 1e-3
 # scan (a significant comb SPEED_SCAN_MARGIN below the declared speed's best); the full scan's range
 # ends there and would miss a factor of exactly 2 (a comb at its edge "would fit better outside").
 FACTOR_WINDOW = 0.06
+# (Not 1/4 and 4: at a quarter of the speed the bearing's lines fall among the shaft's first
+# harmonics, where two lines of 12 dB made an inner-race comb that "contradicted" CWRU B014_2's speed.)
 FACTOR_WINDOWS = tuple((u * (1 - FACTOR_WINDOW), u * (1 + FACTOR_WINDOW)) for u in (0.5, 2.0))
 
 

@@ -64,7 +64,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     n_balls : int
         Number of rolling elements.
     band : tuple of float, optional
-        A fixed demodulation band (Hz); default: the whole band, the kurtogram's and the infogram's.
+        A demodulation band (Hz) of the user's, searched beside the record's own bands (the whole
+        band, the kurtogram's and the infogram's): one view among them.
     shaft_hz : float, optional
         The shaft frequency whose harmonics are claimed first (default f1).
     f1_known : bool
@@ -108,7 +109,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))
     confirmed = f1_known if speed_confirmed is None else speed_confirmed
     other = None if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed)
-    return BearingEvidence(fams, spectra, spectra[0].kurtogram, len(spectra), measured, other)
+    kurtogram = next((s.kurtogram for s in spectra if s.kurtogram is not None), None)
+    return BearingEvidence(fams, spectra, kurtogram, len(spectra), measured, other)
 
 
 def _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefact_hz, shaft_hz, f1_known):
@@ -154,7 +156,11 @@ def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
         if name in FAMILIES and best is not None and "spec" in best:
             fams[name]["decoy_p"] = _decoy_p(where, best, freqs[key], freqs)
         fams[name]["votes"] = len(votes.get(name, ()))
-        fams[name]["views"] = _views(votes.get(name, ()))
+        # a user's band adds no view of its own (``spectra._candidates``): it may confirm what the record's
+        # bands show, and alone it is one view
+        own = [s for s in votes.get(name, ()) if not s.given]
+        fams[name]["views"] = max(_views(own), 1 if len(own) < len(votes.get(name, ())) else 0)
+        fams[name]["band_given_only"] = bool(votes.get(name)) and not own
         if name in FAMILIES and not votes[name]:
             fams[name]["found"] = False   # only ever significant on lines another family explains better
         elif name in FAMILIES and _one_view(fams[name], fams[name]["views"], n_views):
@@ -164,8 +170,10 @@ def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
 
 def _smeared_if_none(fams, spectra, freqs, f1):
     """No family's lines pass and no race's are significant: is the ball's comb there, smeared?"""
+    # a race's comb that only a user's band shows (``band_given_only``) does not stand in the way
     if any(fams[n]["found"] for n in FAMILIES) or any(
-            fams[n]["log_p"] < np.log(ALPHA) for n in FAMILIES if n != "bearing_ball"):
+            fams[n]["log_p"] < np.log(ALPHA) and not fams[n].get("band_given_only")
+            for n in FAMILIES if n != "bearing_ball"):
         return None
     smeared = _smeared_ball(spectra, freqs, f1)
     if smeared is not None:

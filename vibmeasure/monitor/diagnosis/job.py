@@ -216,6 +216,9 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
             chosen.insert(0, idx)
     else:
         chosen = list(dict.fromkeys(named))
+        vibration = [i for i, c in enumerate(rec.channels) if c.quantity not in ("force", "time") and i not in skip]
+        if set(vibration) - set(chosen):   # a channel left out may be the one that sees the fault
+            flags.append("channels_restricted")
     signals = {rec.channels[i].name: (a if i == idx else _accel(rec, i, flags, quality, block))
                for i in chosen}
     if band is not None:

@@ -68,7 +68,9 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
         first of them is also the primary channel unless ``channel`` names another.
         ``extras["channels_used"]`` lists them.
     band : tuple of float, optional
-        A fixed demodulation band (Hz); default the whole band, the kurtogram's and the infogram's.
+        A demodulation band (Hz) of your choice, searched beside the record's own (the whole band, the
+        kurtogram's and the infogram's): a finding in it alone needs overwhelming evidence, as in any
+        single view.
     prewhitening : str or tuple of str
         "cepstral" (default) and/or "ar".
     line_frequency : float, optional
@@ -137,6 +139,22 @@ def _time_base_doubt(speed: dict, severity: dict, conf: float, reason: str) -> t
     if conf > DOUBT_CONFIDENCE:
         reason += (f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f}): the time base is in doubt, check fs "
                    f"and the speed (a factor {r}: rpm for Hz, pulses per revolution)")
+        conf = DOUBT_CONFIDENCE
+    return conf, reason
+
+
+def _band_doubt(ev, job: Job, top: str, conf: float, reason: str) -> tuple[float, str]:
+    """A bearing fault that only the user's band shows (none of the record's own bands, whole, the
+    kurtogram's or the infogram's, claims it first) rests on that band alone: flag ``band_unconfirmed``
+    and hold the confidence under DOUBT_CONFIDENCE. A band that misses the bearing's resonance, or
+    reaches down among the shaft harmonics, demodulates clutter whose combs look like a fault."""
+    if ev is None or top not in ev.families or not ev.families[top].get("band_given_only"):
+        return conf, reason
+    job.flags.append("band_unconfirmed")
+    reason += (f"; only the band given ({job.band[0]:g}-{job.band[1]:g} Hz) shows it, none of the record's own "
+               f"bands: check that band holds the bearing's resonance")
+    if conf > DOUBT_CONFIDENCE:
+        reason += f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f})"
         conf = DOUBT_CONFIDENCE
     return conf, reason
 
@@ -213,6 +231,7 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     top, conf, reason, also, where, (kind, score, parts), p_healthy = _decide(table, job, weak)
     conf, reason = _time_base_doubt(speed, severity, conf, reason)
     conf, reason = _half_speed_doubt(ev, job, conf, reason)
+    conf, reason = _band_doubt(ev, job, top, conf, reason)
     p_healthy = min(p_healthy, conf) if top == "none" else p_healthy
     if unweighed:
         reason += (f"; shaft-order faults not called: the data's unit is unknown, so the ISO 10816-3 level that "
@@ -226,6 +245,9 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
                    + " (above: a filter's stop band): the envelope bands reach down among the shaft harmonics")
     if job.converted:
         reason += "; " + _conversion_note(job.converted)
+    if "channels_restricted" in job.flags:
+        reason += (f"; only {', '.join(map(repr, job.signals))} searched (channels=): a fault another sensor "
+                   "sees is not looked for")
     if job.bearing is None or contradicted:
         job.flags.append("bearing_not_checked")
     extras = {"also": also, "primary": job.primary, "score": score, "confidence_kind": kind,
