@@ -971,3 +971,23 @@ def test_channels_that_leave_sensors_out_are_flagged():
     d = vm.diagnose(two, rpm=1797, bearing="6205-2RS", channels=["a"])
     assert "channels_restricted" in d.flags and "only 'a' searched" in d.reason
     assert "channels_restricted" not in vm.diagnose(two, rpm=1797, bearing="6205-2RS", channels=["a", "b"]).flags
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_healthy_gearbox_is_no_gear_fault(seed):
+    """Every working gearbox carries its mesh with +-1X sidebands (eccentricity, runout): the gear test
+    asked only for a mesh line with one such sideband and called gear_mesh at up to 1.00 on real healthy
+    gearboxes. The null is now a healthy mesh; a fault is the wide sidebands (+-2..6 x a shaft's speed)
+    one shaft's local tooth fault spreads, counted against decoy spacings. A healthy mesh of 1 g
+    (synth.machine(mesh=1.0)) at 10, 0 and -10 dB: no gear call, the answer "none"; a local tooth
+    fault at 0 dB fills 10 or more of the 30 places, beats every decoy and is called."""
+    for snr in (10, 0, -10):
+        rec = vm.synth.machine(fault="none", mesh=1.0, snr_db=snr, seed=seed, duration=6.0)
+        d = vm.diagnose(rec, bearing="6205-2RS", gear=32)
+        row = d.faults.set_index("fault").loc["gear_mesh"]
+        assert row.evidence_db > 20 and row.confidence == 0.0 and d.top == "none", (snr, row.note)
+    rec = vm.synth.machine(fault="gear_mesh", snr_db=0, seed=seed, duration=6.0)
+    d = vm.diagnose(rec, bearing="6205-2RS", gear=vm.Gear(32, mating_shaft_ratio=0.7))
+    row = d.faults.set_index("fault").loc["gear_mesh"]
+    assert d.top == "gear_mesh" and row.sidebands >= 10 and row.decoy_p < 0.05
+    assert "this shaft's" in row.note and "the mating shaft:" in row.note

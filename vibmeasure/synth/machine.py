@@ -45,13 +45,15 @@ _KAISER_BETA = 12.0  # its window: the delay is exact to 1e-3 up to 0.45 fs, lik
 def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: float = 10.0,
             severity: float = 1.0, snr_db: float = 20.0, bearing=None, gear_teeth: int = 32,
             resonance_hz: float = 3500.0, cage_modulation: float = 0.0, shaft_impacts: float = 0.0,
-            seed=None, unit: str = "g", tach: int = 0) -> Record:
+            mesh: float = 0.0, seed=None, unit: str = "g", tach: int = 0) -> Record:
     """Accelerometer record of a rotating machine, healthy or with one fault, for tests and demos.
 
     Every machine has a small residual 1X and broadband noise. Faults: unbalance (strong 1X),
     misalignment (2X beside 1X), looseness (harmonics and 0.5X sub-harmonics), bearing defects
     (impacts at BPFO/BPFI/2 x BSF with 1 % slip jitter ringing a resonance; inner race and ball faults
-    modulated at 1X and FTF), gear mesh (teeth x 1X with 1X sidebands), resonance (a mode 6 % above 1X).
+    modulated at 1X and FTF), gear mesh (a local tooth fault: the mesh of ``gear_teeth`` x 1X modulated by a
+    short pulse once a turn, sidebands at +-1X, 2X, 3X ...), resonance (a mode 6 % above 1X). Any machine
+    may carry a healthy mesh (``mesh``): its line and harmonics with modest +-1X sidebands.
     ``meta`` holds rpm and the truth.
 
     Parameters
@@ -79,6 +81,9 @@ def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: f
         0..1: the noise modulated at the cage rate (a stress case: no fault).
     shaft_impacts : float
         One impact per revolution (a rub), relative to the fault's RMS.
+    mesh : float
+        Amplitude (g) of a healthy gear mesh of ``gear_teeth`` x 1X: harmonics at 1/3 and 1/6 of it,
+        +-1X sidebands at 8 % (eccentricity, runout), a 1 % wander of its amplitude.
     seed : int, optional
         Random seed.
     unit : str
@@ -117,6 +122,10 @@ def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: f
     noise = rng.normal(0, np.sqrt(p_sig / 10 ** (snr_db / 10)), shaft.n)
     noise = _cage_modulated(noise, cage_modulation, shaft, rng, b)
     sig = _with_shaft_impacts(sig, shaft_impacts, shaft, rng, p_sig, resonance_hz)
+    if mesh < 0 or not np.isfinite(mesh):
+        raise ParameterError(f"mesh={mesh!r} must be an amplitude in g >= 0")
+    if mesh:
+        sig = sig + mesh * _healthy_mesh(shaft, rng, gear_teeth)
     return _machine_record(base + sig + noise, shaft, fault, severity, snr_db, unit, tach)
 
 
@@ -171,6 +180,16 @@ def _residual_unbalance(shaft: _Shaft, rng) -> np.ndarray:
     return 0.02 * (speed / 1797.0) * np.sin(shaft.phase(1) + rng.uniform(0, 2 * np.pi))
 
 
+def _healthy_mesh(shaft: _Shaft, rng, teeth: int) -> np.ndarray:
+    """A healthy mesh of unit amplitude: teeth x 1X with its 2nd and 3rd harmonics, +-1X sidebands at
+    8 % (a gear's eccentricity and runout), and a slow 1 % wander of its amplitude (the load)."""
+    revs = shaft.theta if shaft.ramp else shaft.f1 * shaft.t
+    am = 1 + 0.08 * np.cos(2 * np.pi * revs + rng.uniform(0, 2 * np.pi)) \
+        + 0.01 * np.sin(2 * np.pi * 0.37 * shaft.t + rng.uniform(0, 2 * np.pi))
+    return am * sum(a * np.sin(2 * np.pi * k * teeth * revs + rng.uniform(0, 2 * np.pi))
+                    for k, a in ((1, 1.0), (2, 1 / 3), (3, 1 / 6)))
+
+
 def _fault_signal(fault, shaft: _Shaft, rng, b, gear_teeth, resonance_hz) -> np.ndarray:
     """The fault's own vibration (before ``severity``), in g."""
     def ph():
@@ -188,10 +207,12 @@ def _fault_signal(fault, shaft: _Shaft, rng, b, gear_teeth, resonance_hz) -> np.
     elif fault.startswith("bearing"):
         sig = _bearing_impacts(fault, shaft, rng, b, resonance_hz)
     elif fault == "gear_mesh":
-        fm = gear_teeth * shaft.f1
-        mesh = ((lambda k: 2 * np.pi * k * gear_teeth * shaft.theta) if shaft.ramp
-                else (lambda k: 2 * np.pi * k * fm * shaft.t))
-        sig = 0.3 * (1 + 0.5 * np.cos(shaft.phase(1))) * np.sin(mesh(1) + ph()) + 0.1 * np.sin(mesh(2) + ph())
+        # a local tooth fault: once a turn, while the damaged tooth and its neighbours mesh (a pulse
+        # of about 3 of the turn's gear_teeth meshes), the mesh force changes: a pulse on its amplitude
+        revs = shaft.theta if shaft.ramp else shaft.f1 * shaft.t
+        frac = (revs + rng.uniform()) % 1.0 - 0.5
+        pulse = np.exp(-0.5 * (frac * gear_teeth / 1.5) ** 2)
+        sig = 0.3 * (1 + pulse) * _healthy_mesh(shaft, rng, gear_teeth)
     elif fault == "resonance":
         # a structural mode (zeta 0.04) 6 % above 1X: the running speed's force and the broadband
         # forces both come out amplified, the latter as a hump in the noise floor

@@ -23,7 +23,8 @@ from .decide import _decide, _unweighed, candidates
 from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note
 from .mains import supply_lines
 from .severity import iso_severity
-from .shaft import gate_rows, gear_rows, shaft_rows
+from .gears import gear_rows
+from .shaft import gate_rows, shaft_rows
 from .speed import Run, running_speed
 from .tracking import _measured_speed
 

@@ -1,5 +1,5 @@
 """Step: shaft-order faults from the velocity and acceleration spectra: unbalance, misalignment,
-looseness, resonance, twice line frequency (electrical) and gear mesh. Each returns table rows with
+looseness, resonance and twice line frequency (electrical); the gear has its own step (``gears``). Each returns table rows with
 a confidence scaled by ``level`` (0 below half the ISO zone A/B boundary, 1 from it on): a shaft-order
 fault must matter in the overall level before it is called."""
 
@@ -106,18 +106,6 @@ def electrical_row(f, A, f1, line_frequency, level):
                f"2 x line frequency ({2 * lf:g} Hz) line {db:.1f} dB")
 
 
-def gear_row(f, A, f1, gear):
-    """Gear mesh: teeth x 1X with sidebands at +-1X."""
-    df = f[1]
-    fm = gear.teeth * f1
-    fo, am, db = _line(f, A, fm, max(2.5 * df, 0.005 * fm), max(2 * f1, 10 * df))
-    sb = [_line(f, A, fm + s * f1, max(2.5 * df, 0.005 * fm), max(f1, 10 * df))[2] for s in (-1, 1)]
-    e = max(0.0, db - LINE_DB) / 6 + sum(0.5 * max(0.0, s - LINE_DB) / 6 for s in sb)
-    n_sb = sum(s >= LINE_DB for s in sb)
-    return _row("gear_mesh", fm, fo, am, db, (1 - np.exp(-e / 2)) * (n_sb >= 1),
-               f"mesh {gear.teeth} x 1X with sidebands at +-1X ({n_sb} found)")
-
-
 SHAFT_FAULTS = ("unbalance", "misalignment", "looseness", "resonance", "electrical", "gear_mesh")
 
 
@@ -131,11 +119,6 @@ def shaft_rows(run, supply, gate: tuple, line_frequency) -> list:
     if line_frequency is not None:
         rows.append(electrical_row(run.f, run.A, run.f1, line_frequency, level_all))
     return rows
-
-
-def gear_rows(run) -> list:
-    """The gear-mesh row where a gear is given."""
-    return [gear_row(run.f, run.A, run.f1, run.job.gear)] if run.job.gear is not None else []
 
 
 def gate_rows(rows: list, flags: list, contradicted: bool) -> None:
