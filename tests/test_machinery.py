@@ -991,3 +991,20 @@ def test_a_healthy_gearbox_is_no_gear_fault(seed):
     row = d.faults.set_index("fault").loc["gear_mesh"]
     assert d.top == "gear_mesh" and row.sidebands >= 10 and row.decoy_p < 0.05
     assert "this shaft's" in row.note and "the mating shaft:" in row.note
+
+
+def test_an_answer_at_a_speed_nothing_confirms_is_held(shared_data):
+    """CWRU fan-end IR021_0 (inner race) with its sampling rate declared 4x too high: no line stands within
+    12 % of the declared 1X, and the true shaft's harmonics fall where the 6203's 2 x BSF harmonics
+    should be (3.987 X): it was called ball at 1.00 with no flag. An answer at a declared speed that
+    nothing confirms is flagged speed_unconfirmed and held at 0.45; at its own rate nothing changes."""
+    rec = vm.read(shared_data("cwru_fe/IR021_0.mat"), fs=12000, unit="g")
+    fe = next(n for n in rec.names if n.endswith("_FE_time"))
+    wrong = vm.Record.from_array(rec.data, fs=4 * rec.fs, names=list(rec.names), unit="g")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        d = vm.diagnose(wrong, rpm=rec.meta["rpm"], bearing="6203-2RS", channel=fe)
+        right = vm.diagnose(rec, bearing="6203-2RS", channel=fe)
+    assert d.speed["estimated_rpm"] is None and "speed_unconfirmed" in d.flags
+    assert d.confidence <= 0.45 and "no 1X line confirms" in d.reason
+    assert right.top == "bearing_inner_race" and right.confidence > 0.9 and "speed_unconfirmed" not in right.flags

@@ -144,6 +144,24 @@ def _time_base_doubt(speed: dict, severity: dict, conf: float, reason: str) -> t
     return conf, reason
 
 
+def _unconfirmed_speed(speed: dict, job: Job, conf: float, reason: str) -> tuple[float, str]:
+    """An answer given at a declared speed that nothing confirms (no 1X line within the search, no
+    tachometer, no contradiction found either) rests on that speed alone: every line was looked for
+    where it puts them. A sampling rate declared 4x too high puts the 6203's shaft harmonics where its
+    2 x BSF harmonics should be (3.987 X): CWRU fan-end inner-race records read as ball at 1.00, and a
+    "none" there looked for every fault where none could be. Flag
+    ``speed_unconfirmed`` and hold the confidence under DOUBT_CONFIDENCE. (Every development record
+    shows its 1X: none of them is held.)"""
+    if speed.get("estimated_rpm") is not None or not speed.get("consistent", True):
+        return conf, reason
+    job.flags.append("speed_unconfirmed")
+    if conf > DOUBT_CONFIDENCE:
+        reason += (f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f}): no 1X line confirms the declared "
+                   f"{job.rpm:g} rpm; check the speed and fs, or give tach=")
+        conf = DOUBT_CONFIDENCE
+    return conf, reason
+
+
 def _band_doubt(ev, job: Job, top: str, conf: float, reason: str) -> tuple[float, str]:
     """A bearing fault that only the user's band shows (none of the record's own bands, whole, the
     kurtogram's or the infogram's, claims it first) rests on that band alone: flag ``band_unconfirmed``
@@ -233,6 +251,7 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     conf, reason = _time_base_doubt(speed, severity, conf, reason)
     conf, reason = _half_speed_doubt(ev, job, conf, reason)
     conf, reason = _band_doubt(ev, job, top, conf, reason)
+    conf, reason = _unconfirmed_speed(speed, job, conf, reason)
     p_healthy = min(p_healthy, conf) if top == "none" else p_healthy
     if unweighed:
         reason += (f"; shaft-order faults not called: the data's unit is unknown, so the ISO 10816-3 level that "
