@@ -980,7 +980,8 @@ def test_a_healthy_gearbox_is_no_gear_fault(seed):
     gearboxes. The null is now a healthy mesh; a fault is the wide sidebands (+-2..6 x a shaft's speed)
     one shaft's local tooth fault spreads, counted against decoy spacings. A healthy mesh of 1 g
     (synth.machine(mesh=1.0)) at 10, 0 and -10 dB: no gear call, the answer "none"; a local tooth
-    fault at 0 dB fills 10 or more of the 30 places, beats every decoy and is called."""
+    fault at 0 dB fills 10 or more of the 30 places, beats every decoy and is called; a rub (one impact
+    a turn, its harmonics at every order) is no gear fault."""
     for snr in (10, 0, -10):
         rec = vm.synth.machine(fault="none", mesh=1.0, snr_db=snr, seed=seed, duration=6.0)
         d = vm.diagnose(rec, bearing="6205-2RS", gear=32)
@@ -1006,5 +1007,8 @@ def test_an_answer_at_a_speed_nothing_confirms_is_held(shared_data):
         d = vm.diagnose(wrong, rpm=rec.meta["rpm"], bearing="6203-2RS", channel=fe)
         right = vm.diagnose(rec, bearing="6203-2RS", channel=fe)
     assert d.speed["estimated_rpm"] is None and "speed_unconfirmed" in d.flags
-    assert d.confidence <= 0.45 and "no 1X line confirms" in d.reason
+    assert d.confidence <= 0.45 and "no 1X line confirms" in d.reason and "a shaft comb stands at 4 x it" in d.reason
     assert right.top == "bearing_inner_race" and right.confidence > 0.9 and "speed_unconfirmed" not in right.flags
+    for s in range(3):
+        rub = vm.synth.machine(fault="none", shaft_impacts=0.5, snr_db=0, seed=7000 + s, duration=6.0)
+        assert vm.diagnose(rub, bearing="6205-2RS", gear=32).top != "gear_mesh"

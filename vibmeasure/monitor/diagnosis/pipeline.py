@@ -24,6 +24,7 @@ from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note
 from .mains import supply_lines
 from .severity import iso_severity
 from .gears import gear_rows
+from .lines import LINE_DB, _line
 from .shaft import gate_rows, shaft_rows
 from .speed import Run, running_speed
 from .tracking import _measured_speed
@@ -144,20 +145,31 @@ def _time_base_doubt(speed: dict, severity: dict, conf: float, reason: str) -> t
     return conf, reason
 
 
-def _unconfirmed_speed(speed: dict, job: Job, conf: float, reason: str) -> tuple[float, str]:
-    """An answer given at a declared speed that nothing confirms (no 1X line within the search, no
-    tachometer, no contradiction found either) rests on that speed alone: every line was looked for
-    where it puts them. A sampling rate declared 4x too high puts the 6203's shaft harmonics where its
-    2 x BSF harmonics should be (3.987 X): CWRU fan-end inner-race records read as ball at 1.00, and a
-    "none" there looked for every fault where none could be. Flag
-    ``speed_unconfirmed`` and hold the confidence under DOUBT_CONFIDENCE. (Every development record
-    shows its 1X: none of them is held.)"""
+SHAFT_ELSEWHERE = (2, 3, 4)   # a shaft comb at these multiples of a declared 1X that does not show
+
+
+def _unconfirmed_speed(run: Run, conf: float, reason: str) -> tuple[float, str]:
+    """No 1X line confirms the declared speed (no tachometer, no contradiction either), yet a shaft comb
+    stands at 2, 3 or 4 x it (three of its first four harmonics 12 dB over their floor): the true speed
+    may be that multiple (a sampling rate declared that many times too high), and every line was looked
+    for where the declared speed alone puts it. A sampling rate declared 4x too high puts the 6203's
+    shaft harmonics where its 2 x BSF harmonics should be (3.987 X): CWRU fan-end inner-race records
+    read as ball at 1.00. Flag ``speed_unconfirmed`` and hold the confidence under DOUBT_CONFIDENCE. A
+    1X merely buried in noise (synthetic machines at -10 dB) shows no such comb and is not held."""
+    speed, job = run.speed, run.job
     if speed.get("estimated_rpm") is not None or not speed.get("consistent", True):
         return conf, reason
+    df = run.f[1]
+    combs = [k for k in SHAFT_ELSEWHERE
+             if sum(_line(run.f, run.A, m * k * run.f1, max(2 * df, 0.01 * m * k * run.f1),
+                          m * k * run.f1 + 5 * df)[2] >= LINE_DB for m in (1, 2, 3, 4)) >= 3]
+    if not combs:
+        return conf, reason
     job.flags.append("speed_unconfirmed")
+    reason += (f"; no 1X line confirms the declared {job.rpm:g} rpm, and a shaft comb stands at {combs[0]} x it: "
+               "check the speed and fs, or give tach=")
     if conf > DOUBT_CONFIDENCE:
-        reason += (f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f}): no 1X line confirms the declared "
-                   f"{job.rpm:g} rpm; check the speed and fs, or give tach=")
+        reason += f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f})"
         conf = DOUBT_CONFIDENCE
     return conf, reason
 
@@ -251,7 +263,7 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     conf, reason = _time_base_doubt(speed, severity, conf, reason)
     conf, reason = _half_speed_doubt(ev, job, conf, reason)
     conf, reason = _band_doubt(ev, job, top, conf, reason)
-    conf, reason = _unconfirmed_speed(speed, job, conf, reason)
+    conf, reason = _unconfirmed_speed(run, conf, reason)
     p_healthy = min(p_healthy, conf) if top == "none" else p_healthy
     if unweighed:
         reason += (f"; shaft-order faults not called: the data's unit is unknown, so the ISO 10816-3 level that "
