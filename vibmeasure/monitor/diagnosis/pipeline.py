@@ -4,7 +4,8 @@ prepare (``job``: channels, units, damage, bearing, limits) -> running speed (``
 the 1X, its consistency with fs, order tracking) -> the supply's lines (``mains``) -> ISO 10816-3
 severity (``severity``) -> shaft-order faults (``shaft``: gated by severity) -> bearing families
 (``bearings``: the statistical test of monitor/bearing on every channel, never gated by severity)
--> decision (``decide``: the top, its calibrated confidence and its reason).
+-> the gear (``gears``) -> decision (``decide``: the top, its calibrated confidence and its reason)
+-> the doubts the answer carries (``doubts``: time base, speed, factor 2, the user's band).
 """
 
 from __future__ import annotations
@@ -16,15 +17,13 @@ from ...core._validate import as_record, memory_guard
 from ...core.errors import warn_quality
 from ...core.units import quantity_of
 from ...core.results import Diagnosis
-from ..bearing.families import HALVES
-from ..bearing.rules import ALPHA
 from .bearings import _narrow_channels, _plot_material, bearing_step
+from . import doubts
 from .decide import _decide, _unweighed, candidates
 from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note
 from .mains import supply_lines
 from .severity import iso_severity
 from .gears import gear_rows
-from .lines import LINE_DB, _line
 from .shaft import gate_rows, shaft_rows
 from .speed import Run, running_speed
 from .tracking import _measured_speed
@@ -122,97 +121,6 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     return _answer(run, rows, ev, severity, narrow, contradicted)
 
 
-DOUBT_CONFIDENCE = 0.45   # an answer whose time base is in doubt stays under the 0.5 a confident answer needs
-
-
-def _time_base_doubt(speed: dict, severity: dict, conf: float, reason: str) -> tuple[float, str]:
-    """When the lines fit the declared speed only at another fs (or another speed by the same factor:
-    rpm for Hz, pulses per revolution), every frequency the answer rests on may be off by that factor:
-    the confidence is held under DOUBT_CONFIDENCE and the ISO zone withdrawn (the velocity scales with
-    the time base). Before, CWRU Normal_0 read at a quarter of its rate was answered 'none' at 0.97
-    with a zone from a velocity four times too high."""
-    r = speed.get("fs_ratio", 1)
-    if r == 1:
-        return conf, reason
-    if severity.get("zone") is not None:
-        severity["zone"] = None
-        severity["note"] = "; ".join(filter(None, [severity.get("note", ""), (
-            f"no zone: the time base is in doubt (the lines fit only at {r}x fs, or {r}x the declared speed)")]))
-    if conf > DOUBT_CONFIDENCE:
-        reason += (f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f}): the time base is in doubt, check fs "
-                   f"and the speed (a factor {r}: rpm for Hz, pulses per revolution)")
-        conf = DOUBT_CONFIDENCE
-    return conf, reason
-
-
-SHAFT_ELSEWHERE = (2, 3, 4)   # a shaft comb at these multiples of a declared 1X that does not show
-
-
-def _unconfirmed_speed(run: Run, conf: float, reason: str) -> tuple[float, str]:
-    """No 1X line confirms the declared speed (no tachometer, no contradiction either), yet a shaft comb
-    stands at 2, 3 or 4 x it (three of its first four harmonics 12 dB over their floor): the true speed
-    may be that multiple (a sampling rate declared that many times too high), and every line was looked
-    for where the declared speed alone puts it. A sampling rate declared 4x too high puts the 6203's
-    shaft harmonics where its 2 x BSF harmonics should be (3.987 X): CWRU fan-end inner-race records
-    read as ball at 1.00. Flag ``speed_unconfirmed`` and hold the confidence under DOUBT_CONFIDENCE. A
-    1X merely buried in noise (synthetic machines at -10 dB) shows no such comb and is not held."""
-    speed, job = run.speed, run.job
-    if speed.get("estimated_rpm") is not None or not speed.get("consistent", True):
-        return conf, reason
-    df = run.f[1]
-    combs = [k for k in SHAFT_ELSEWHERE
-             if sum(_line(run.f, run.A, m * k * run.f1, max(2 * df, 0.01 * m * k * run.f1),
-                          m * k * run.f1 + 5 * df)[2] >= LINE_DB for m in (1, 2, 3, 4)) >= 3]
-    if not combs:
-        return conf, reason
-    job.flags.append("speed_unconfirmed")
-    reason += (f"; no 1X line confirms the declared {job.rpm:g} rpm, and a shaft comb stands at {combs[0]} x it: "
-               "check the speed and fs, or give tach=")
-    if conf > DOUBT_CONFIDENCE:
-        reason += f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f})"
-        conf = DOUBT_CONFIDENCE
-    return conf, reason
-
-
-def _band_doubt(ev, job: Job, top: str, conf: float, reason: str) -> tuple[float, str]:
-    """A bearing fault that only the user's band shows (none of the record's own bands, whole, the
-    kurtogram's or the infogram's, claims it first) rests on that band alone: flag ``band_unconfirmed``
-    and hold the confidence under DOUBT_CONFIDENCE. A band that misses the bearing's resonance, or
-    reaches down among the shaft harmonics, demodulates clutter whose combs look like a fault."""
-    if ev is None or top not in ev.families or not ev.families[top].get("band_given_only"):
-        return conf, reason
-    job.flags.append("band_unconfirmed")
-    reason += (f"; only the band given ({job.band[0]:g}-{job.band[1]:g} Hz) shows it, none of the record's own "
-               f"bands: check that band holds the bearing's resonance")
-    if conf > DOUBT_CONFIDENCE:
-        reason += f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f})"
-        conf = DOUBT_CONFIDENCE
-    return conf, reason
-
-
-def _half_speed_doubt(ev, job: Job, conf: float, reason: str) -> tuple[float, str]:
-    """A bearing family whose significant comb is refused because lines stand halfway between its
-    harmonics (``bearing.families._accepted``, HALVES) is the even part of a comb at half its
-    fundamental: the true speed may be half the declared one. Whatever else the lines make of the
-    declared speed then rests on a doubtful speed (MFPT's outer race declared at twice its speed
-    read as inner race at 1.00 from BPFO x 3, 6, 9 at +1.2 % slip): flag ``speed_doubtful`` and hold the
-    confidence under DOUBT_CONFIDENCE."""
-    if ev is None:
-        return conf, reason
-    # the cage is left out: its comb is reported, never called, and FTF's half-harmonics are dense
-    halved = [n for n, fam in ev.families.items() if n != "bearing_cage" and fam.get("halves", 0) >= HALVES
-              and fam["log_p"] < np.log(ALPHA)]
-    if not halved:
-        return conf, reason
-    job.flags.append("speed_doubtful")
-    reason += (f"; {', '.join(halved)}: lines stand halfway between its harmonics, a comb at half its fundamental: "
-               f"the speed may be half the declared {job.rpm:g} rpm (rpm for Hz, pulses per revolution)")
-    if conf > DOUBT_CONFIDENCE:
-        reason += f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f}): check the speed"
-        conf = DOUBT_CONFIDENCE
-    return conf, reason
-
-
 def _conversion_note(converted: dict) -> str:
     """What was made of channels in velocity or displacement units, and the standard's scope."""
     by_unit: dict = {}
@@ -260,10 +168,7 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     unweighed = _unweighed(rows) if "unit_unknown" in job.flags else None
     table = pd.DataFrame(rows).sort_values("confidence", ascending=False, ignore_index=True)
     top, conf, reason, also, where, (kind, score, parts), p_healthy = _decide(table, job, weak)
-    conf, reason = _time_base_doubt(speed, severity, conf, reason)
-    conf, reason = _half_speed_doubt(ev, job, conf, reason)
-    conf, reason = _band_doubt(ev, job, top, conf, reason)
-    conf, reason = _unconfirmed_speed(run, conf, reason)
+    conf, reason = doubts.hold_all(run, ev, severity, top, conf, reason)
     p_healthy = min(p_healthy, conf) if top == "none" else p_healthy
     if unweighed:
         reason += (f"; shaft-order faults not called: the data's unit is unknown, so the ISO 10816-3 level that "
