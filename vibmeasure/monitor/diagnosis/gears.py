@@ -84,7 +84,7 @@ def gear_rows(run) -> list:
     # a shaft's own comb (impacts once a turn, a rub, looseness) stands at every order, around the mesh
     # and between its harmonics alike: only what stands around the mesh beyond what stands halfway
     # between (``shift`` -0.5) is the mesh's modulation. (Without this, a healthy machine with a rub
-    # was called gear_mesh on 17 of 30 synthetic records.)
+    # was called gear_mesh on 18 of 30 synthetic records.)
     counts = {name: max(0, _count(A, df, fm, s, top, tol, ring) - _count(A, df, fm, s, top, tol, ring, -0.5))
               for name, s in shafts}
     decoy = np.array([_count(A, df, fm, u, top, tol, ring) - _count(A, df, fm, u, top, tol, ring, -0.5)
