@@ -405,13 +405,53 @@ def _integral(x: np.ndarray, fs: float, hp: float, method: str) -> np.ndarray:
     return _sig.sosfiltfilt(sos, y) if sos is not None else y   # what it made of the residual low frequencies
 
 
-def derivative(x: np.ndarray, fs: float, order: int = 1, *, extension: int | None = None) -> np.ndarray:
-    """The ``order``-th time derivative of the samples x, X(f) (i 2 pi f)^order over the transform of x
-    continued past both ends (``extend``, default a quarter of the record each side): without the
-    continuation the jump between the last and the first sample rings through the derivative."""
+def derivative(x, fs: float, order: int = 1, *, extension: int | None = None) -> np.ndarray:
+    """The ``order``-th time derivative of samples, over the transform of the record continued past
+    both ends.
+
+    X(f) (i 2 pi f)^order over the samples continued by AR prediction (``extend``; default a quarter
+    of the record each side): without the continuation the jump between the last and the first sample
+    rings through the derivative. ``vm.differentiate`` and the diagnosis's unit conversion use it.
+
+    Parameters
+    ----------
+    x : array_like
+        1-D finite samples.
+    fs : float
+        Sampling rate in Hz.
+    order : int
+        1 (velocity from displacement, acceleration from velocity) or more.
+    extension : int, optional
+        Samples added at each end (default ``len(x) // 4``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The derivative, as many samples as ``x``.
+
+    Raises
+    ------
+    ParameterError
+        For a non-positive fs, an order that is not a whole number >= 1, or samples that are not 1-D
+        and finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from vibmeasure.signal.preprocess import derivative
+    >>> t = np.arange(4000) / 1000.0
+    >>> v = derivative(np.sin(2 * np.pi * 5 * t), 1000.0)
+    >>> bool(abs(v[2000] - 2 * np.pi * 5 * np.cos(2 * np.pi * 5 * t[2000])) < 1e-3)
+    True
+    """
+    fs = positive(fs, "fs")
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 1:
+        raise ParameterError(f"order={order!r} must be a whole number >= 1 (1: one derivative)")
     x = np.asarray(x, float)
     n = x.size
     L = n // 4 if extension is None else int(extension)
+    if x.ndim != 1 or not np.isfinite(x).all():
+        raise ParameterError("x must be a 1-D array of finite samples: the transform would spread a NaN/inf everywhere")
     xe = extend(x - x.mean(), L)   # the offset has no derivative; the taper would make one of it
     N = _fft.next_fast_len(xe.size, real=True)
     f = np.fft.rfftfreq(N, 1 / fs)
