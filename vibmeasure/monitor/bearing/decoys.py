@@ -118,9 +118,12 @@ def _declared(hz: list, freqs: dict, df: float) -> bool:
                                 for f in (freqs["BPFO"], freqs["BPFI"], freqs["BSF"], freqs["2xBSF"])) for h in hz)
 
 
-def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, confirmed: bool = False) -> dict | None:
-    """The bearing comb that contradicts the declared speed (see SPEED_SCAN; where a 1X ``confirmed`` the
-    speed, only within FACTOR_WINDOWS), or None: {"factor": true
+def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, confirmed: bool = False) -> tuple:
+    """(contradiction, rival). The contradiction: the bearing comb that contradicts the declared speed
+    (see SPEED_SCAN; where a 1X ``confirmed`` the speed, only within FACTOR_WINDOWS), or None. The
+    rival: the best significant comb within FACTOR_WINDOWS when it does not contradict the speed yet is
+    not SPEED_SCAN_MARGIN weaker than the declared speed's best (both may saturate: a line counts up to
+    R_CAP), or None: {"factor", "family", "model", "p_value", "declared_p_value"}. A contradiction: {"factor": true
     over declared speed, "family", "model", "p_value", "declared_p_value", "lines": [(Hz, dB)], "channel",
     "preprocessing", "other_factors"}. Both sides are judged on the same lines: every spectrum after the
     shaft's and the cage's claims (``r_base``), every family at the declared speed (its +-SLIP, and
@@ -155,13 +158,13 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
                     c = _scanned(res, ses, freqs, key, harmonics, side, sp, f1, speed_search,
                                  np.log(len(models)) + np.log(n_sp), (lo, hi) in FACTOR_WINDOWS)
                     if c is not None:
-                        found.append((c[0], dict(c[1], family=name)))
+                        found.append((c[0], dict(c[1], family=name, factor_window=(lo, hi) in FACTOR_WINDOWS)))
     if not found:
-        return None
+        return None, None
     found.sort(key=lambda c: c[0])
     logp, best = found[0]
     if logp >= np.log(ALPHA) or logp >= declared + np.log(SPEED_SCAN_MARGIN):
-        return None
+        return None, _rival(found, declared)
     best["declared_p_value"] = float(np.exp(declared))
     # another family's comb at another speed may fit the same lines nearly as well (a 6205's BPFO x 1-3
     # is its BSF x 1-3 at 1.52 x the speed): those speeds are named too
@@ -171,7 +174,19 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
                                                            for u in [best["factor"]] + others):
             others.append(c["factor"])
     best["other_factors"] = others
-    return best
+    return best, None
+
+
+def _rival(found: list, declared: float) -> dict | None:
+    """The best comb of ``found`` (sorted (log p, comb)) within FACTOR_WINDOWS, significant and not
+    SPEED_SCAN_MARGIN weaker than the declared speed's best (log p ``declared``), or None."""
+    for lp, c in found:
+        if c["factor_window"]:
+            if lp < np.log(ALPHA) and lp < declared - np.log(SPEED_SCAN_MARGIN):
+                return {"factor": c["factor"], "family": c["family"], "model": c["model"],
+                        "p_value": float(np.exp(lp)), "declared_p_value": float(np.exp(declared))}
+            return None
+    return None
 
 
 def _scanned(res, ses, freqs, key, harmonics, side, sp, f1, speed_search, penalty, factor_window=False):

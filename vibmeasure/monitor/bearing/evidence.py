@@ -35,6 +35,10 @@ class BearingEvidence:
         Channel -> upper edge of the band it measures (below an anti-alias filter's edge).
     speed_scan : dict or None
         A comb that stands where another speed puts it and contradicts the declared speed.
+    factor_rival : dict or None
+        The best significant comb near 0.5 or 2 x the speed that does not contradict it, when it is
+        not SPEED_SCAN_MARGIN weaker than the declared speed's best: {"factor", "family", "model",
+        "p_value", "declared_p_value"} (``decoys._speed_scan``).
     """
 
     families: dict
@@ -43,6 +47,7 @@ class BearingEvidence:
     n_spectra: int
     measured_top_hz: dict
     speed_scan: dict | None
+    factor_rival: dict | None = None
 
 
 def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: int, *, band=None,
@@ -108,9 +113,9 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     smeared = _smeared_if_none(fams, spectra, freqs, f1) if smeared_ball else None
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))
     confirmed = f1_known if speed_confirmed is None else speed_confirmed
-    other = None if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed)
+    other, rival = (None, None) if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed)
     kurtogram = next((s.kurtogram for s in spectra if s.kurtogram is not None), None)
-    return BearingEvidence(fams, spectra, kurtogram, len(spectra), measured, other)
+    return BearingEvidence(fams, spectra, kurtogram, len(spectra), measured, other, rival)
 
 
 def _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefact_hz, shaft_hz, f1_known):
@@ -170,8 +175,8 @@ def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
 
 def _smeared_if_none(fams, spectra, freqs, f1):
     """No family's lines pass and no race's are significant: is the ball's comb there, smeared?"""
-    # a race's comb that only a user's band shows (``band_given_only``) does not stand in the way
-    if any(fams[n]["found"] for n in FAMILIES) or any(
+    # a comb that only a user's band shows (``band_given_only``) does not stand in the way
+    if any(fams[n]["found"] and not fams[n].get("band_given_only") for n in FAMILIES) or any(
             fams[n]["log_p"] < np.log(ALPHA) and not fams[n].get("band_given_only")
             for n in FAMILIES if n != "bearing_ball"):
         return None

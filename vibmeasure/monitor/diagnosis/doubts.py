@@ -8,19 +8,21 @@ from __future__ import annotations
 import numpy as np
 
 from ..bearing.families import HALVES
-from ..bearing.rules import ALPHA
+from ..bearing.rules import ALPHA, SLIP
 from .lines import LINE_DB, _line
+from .speed import SPEED_NOTED, _confirmed
 
 DOUBT_CONFIDENCE = 0.45   # a doubtful answer stays under the 0.5 a confident answer needs
 SHAFT_ELSEWHERE = (2, 3, 4)   # a shaft comb at these multiples of a declared 1X that does not show
 
 
-def _held(flags: list, flag: str, why: str, conf: float, reason: str) -> tuple[float, str]:
-    """The answer with ``flag`` set, ``why`` in its reason and its confidence held under DOUBT_CONFIDENCE."""
+def _held(flags: list, flag: str, why: str, conf: float, reason: str, hold: bool = True) -> tuple[float, str]:
+    """The answer with ``flag`` set, ``why`` in its reason and (``hold``) its confidence held under
+    DOUBT_CONFIDENCE."""
     if flag not in flags:
         flags.append(flag)
     reason += "; " + why
-    if conf > DOUBT_CONFIDENCE:
+    if hold and conf > DOUBT_CONFIDENCE:
         reason += f"; confidence held at {DOUBT_CONFIDENCE} (was {conf:.2f})"
         conf = DOUBT_CONFIDENCE
     return conf, reason
@@ -50,26 +52,57 @@ def unconfirmed_speed(run, conf: float, reason: str) -> tuple[float, str]:
     for where the declared speed alone puts it. A sampling rate declared 4x too high puts the 6203's
     shaft harmonics where its 2 x BSF harmonics should be (3.987 X): CWRU fan-end inner-race records
     read as ball at 1.00. Flag ``speed_unconfirmed``. A 1X merely buried in noise (synthetic machines at
-    -10 dB) shows no such comb and is not held."""
+    -10 dB) shows no such comb and is not held. A 1X found away from the declared speed
+    (``speed_corrected``) with its harmonics (``speed._confirmed``: the bearing's lines are then searched
+    at other speeds only near a factor 2; without them, at every speed from 0.5 to 2 x) confirms nothing either: a comb counts there when it is not that 1X's own and
+    its first line stands at least as high as that 1X (CWRU fan-end OR021@6_0 read at 4 x fs took a line
+    5.5 % below the declared speed for its 1X and read as ball at 0.72; IR007_1, whose file states a
+    speed 2.4 % slow, shows scattered lines near 2-4 x the declared speed under its strong true 1X)."""
     speed, job = run.speed, run.job
-    if speed.get("estimated_rpm") is not None or not speed.get("consistent", True):
+    corrected = "speed_corrected" in job.flags and _confirmed(speed)
+    if (speed.get("estimated_rpm") is not None and not corrected) or not speed.get("consistent", True):
         return conf, reason
-    df = run.f[1]
-    combs = [k for k in SHAFT_ELSEWHERE
-             if sum(_line(run.f, run.A, m * k * run.f1, max(2 * df, 0.01 * m * k * run.f1),
-                          m * k * run.f1 + 5 * df)[2] >= LINE_DB for m in (1, 2, 3, 4)) >= 3]
+    df, f0 = run.f[1], job.rpm / 60.0
+    combs = []
+    for k in SHAFT_ELSEWHERE:
+        if corrected and _harmonic_of(k * f0, run.f1):
+            continue
+        db = [_line(run.f, run.A, m * k * f0, max(2 * df, 0.01 * m * k * f0), m * k * f0 + 5 * df)[2]
+              for m in (1, 2, 3, 4)]
+        # beside a 1X found, the comb must outstand it: its first line at least as high
+        if sum(d >= LINE_DB for d in db) >= 3 and (not corrected or db[0] >= speed["one_x_db"]):
+            combs.append(k)
     if not combs:
         return conf, reason
-    return _held(job.flags, "speed_unconfirmed", f"no 1X line confirms the declared {job.rpm:g} rpm, and a shaft "
-                 f"comb stands at {combs[0]} x it: check the speed and fs, or give tach=", conf, reason)
+    said = (f"the 1X taken, at {60 * run.f1:.0f} rpm, is off the declared {job.rpm:g} rpm" if corrected else
+            f"no 1X line confirms the declared {job.rpm:g} rpm")
+    return _held(job.flags, "speed_unconfirmed", f"{said}, and a shaft comb stands at {combs[0]} x the declared "
+                 "speed: check the speed and fs, or give tach=", conf, reason)
+
+
+def _harmonic_of(f: float, f1: float) -> bool:
+    """Whether f stands within 1 % of a whole multiple of f1 (that shaft's own comb)."""
+    k = max(1, round(f / f1))
+    return abs(f / (k * f1) - 1) <= 0.01
 
 
 def band_given(ev, job, top: str, conf: float, reason: str) -> tuple[float, str]:
     """A bearing fault that only the user's band shows (none of the record's own bands, whole, the
     kurtogram's or the infogram's, claims it first) rests on that band alone: flag ``band_unconfirmed``.
     A band that misses the bearing's resonance, or reaches down among the shaft harmonics, demodulates
-    clutter whose combs look like a fault."""
-    if ev is None or top not in ev.families or not ev.families[top].get("band_given_only"):
+    clutter whose combs look like a fault. An answer that names no fault says so of its strongest
+    bearing candidate too (the flag, no hold: it names nothing)."""
+    if ev is None or job.band is None:
+        return conf, reason
+    if top == "undetermined":   # the strongest bearing candidate, when only the band given shows it
+        fams = [n for n in ev.families if n != "bearing_cage" and ev.families[n]["log_p"] < np.log(ALPHA)]
+        name = min(fams, key=lambda n: ev.families[n]["log_p"], default=None)
+        if name is None or not ev.families[name].get("band_given_only"):
+            return conf, reason
+        return _held(job.flags, "band_unconfirmed", f"the strongest bearing candidate, {name}, only the band given "
+                     f"({job.band[0]:g}-{job.band[1]:g} Hz) shows: check that band holds the bearing's resonance",
+                     conf, reason, hold=False)
+    if top not in ev.families or not ev.families[top].get("band_given_only"):
         return conf, reason
     return _held(job.flags, "band_unconfirmed", f"only the band given ({job.band[0]:g}-{job.band[1]:g} Hz) shows "
                  "it, none of the record's own bands: check that band holds the bearing's resonance", conf, reason)
@@ -93,9 +126,72 @@ def half_speed(ev, job, conf: float, reason: str) -> tuple[float, str]:
                  "pulses per revolution)", conf, reason)
 
 
+def file_speed(run, conf: float, reason: str) -> tuple[float, str]:
+    """A declared rpm that differs from the speed the file states (``Job.file_rpm``) by more than
+    SPEED_NOTED, where neither a tachometer nor a 1X line settles which is right (a 1X at the file's
+    speed; or one at the declared speed with no line at the file's: a shaft's 2X stands at twice its
+    speed, so a line at a declared speed of twice the file's settles nothing): one of them is a mistake (rpm for Hz, pulses per revolution, another shaft, a
+    nameplate speed), and every bearing line was put where the declared one says. Flag
+    ``speed_disagrees_file``. MFPT's outer-race record declared 1.2 x the 1500 rpm its file states (its 1X
+    too weak to be found) read as ball at 1.00; CWRU OR007@6_0 declared 2 x read as inner race at 0.92
+    through a line at 2.07 x the true speed taken for the 1X. A speed the record contradicts names no
+    fault already: there the file's speed is only said."""
+    job, speed = run.job, run.speed
+    if job.file_rpm is None or abs(job.rpm / job.file_rpm - 1) <= SPEED_NOTED or speed.get("source") is not None:
+        return conf, reason
+    measured = speed.get("estimated_rpm")
+    if measured is not None and abs(measured / job.file_rpm - 1) <= SPEED_NOTED:
+        return conf, reason
+    f_file, df = job.file_rpm / 60.0, run.f[1]
+    file_line = _line(run.f, run.A, f_file, max(2 * df, SPEED_NOTED * f_file), f_file + 5 * df)[2] >= LINE_DB
+    if measured is not None and abs(measured / job.rpm - 1) <= SPEED_NOTED and not file_line:
+        return conf, reason
+    return _held(job.flags, "speed_disagrees_file", f"the file states {job.file_rpm:g} rpm, the declared "
+                 f"{job.rpm:g} rpm ({job.rpm / job.file_rpm:.3g} x) was used and no 1X line settles which is right: "
+                 "check the speed (rpm for Hz, pulses per revolution), or give tach=", conf, reason,
+                 hold="speed_contradicted" not in job.flags)
+
+
+def factor_rival(run, ev, conf: float, reason: str) -> tuple[float, str]:
+    """The 1X was found away from the declared speed (``speed_corrected``: the declared speed is wrong
+    already), and the bearing's lines make a comb near 0.5 or 2 x the speed used as significant as any
+    at that speed (``BearingEvidence.factor_rival``: both may saturate). Which speed is the shaft's the
+    lines cannot tell, and the 1X taken may be another line (a supply line, another shaft's): flag
+    ``speed_doubtful``. CWRU OR014@3_3 read at half its sampling rate took the 60 Hz supply's image,
+    4 % above the declared speed, for its 1X and read as inner race at 0.88, while the outer race's comb
+    stood at 0.48 x that speed (the true one), p = 1e-101 as against 1e-55."""
+    rival = None if ev is None else ev.factor_rival
+    if rival is None or "speed_corrected" not in run.job.flags:
+        return conf, reason
+    return _held(run.job.flags, "speed_doubtful", f"a {rival['family']} comb ({rival['model']}, p = "
+                 f"{rival['p_value']:.2g}) stands where {60 * run.f1 * rival['factor']:.0f} rpm "
+                 f"({rival['factor']:.2f} x the speed used) puts it, as clearly as any at the speed used: check "
+                 "the speed and fs (a factor 2: rpm for Hz, pulses per revolution), or give tach=", conf, reason)
+
+
+def ball_slip_edge(ev, job, top: str, conf: float, reason: str) -> tuple[float, str]:
+    """A ball called from its smeared comb (humps at 2 x BSF and its harmonics, no line comb) whose best
+    common slip is the search's edge (+-SLIP): the humps would fit better outside the range the model
+    allows, so they may be another comb's skirts, or the ball's spin is further off its kinematic value
+    than the model assumes. A line comb at its edge is refused for that reason; the smeared comb, wide by
+    nature, is called but held: flag ``ball_slip_edge``. CWRU fan-end B007_1 and B014_1 are found so
+    (slip -2.00 %)."""
+    fam = None if ev is None else ev.families.get("bearing_ball")
+    sm = None if fam is None else fam.get("smeared")
+    if top != "bearing_ball" or sm is None or not sm.get("found") or abs(sm["slip"]) < SLIP * (1 - 1e-9):
+        return conf, reason
+    return _held(job.flags, "ball_slip_edge", f"the smeared ball comb fits best at the edge of the slip searched "
+                 f"({100 * sm['slip']:+.2f} %): a longer record, or one under another load, should show whether "
+                 "the humps follow 2 x BSF", conf, reason)
+
+
 def hold_all(run, ev, severity: dict, top: str, conf: float, reason: str) -> tuple[float, str]:
-    """Every doubt in turn: the time base, a speed nothing confirms, a factor 2, the user's band."""
+    """Every doubt in turn: the time base, a speed the file contradicts, a speed nothing confirms, a
+    factor 2 (half-harmonics, a rival comb), a smeared ball at its slip's edge, the user's band."""
     conf, reason = time_base(run.speed, severity, run.job.flags, conf, reason)
+    conf, reason = file_speed(run, conf, reason)
     conf, reason = unconfirmed_speed(run, conf, reason)
     conf, reason = half_speed(ev, run.job, conf, reason)
+    conf, reason = factor_rival(run, ev, conf, reason)
+    conf, reason = ball_slip_edge(ev, run.job, top, conf, reason)
     return band_given(ev, run.job, top, conf, reason)

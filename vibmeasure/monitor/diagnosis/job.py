@@ -39,6 +39,7 @@ class Job:
     mains: tuple = (50.0, 60.0)  # the line frequencies whose lines are electrical (``_at_mains``)
     quality: dict = field(default_factory=dict)   # channel -> damage found in its samples (``_damage``)
     converted: dict = field(default_factory=dict)  # channel -> the velocity or displacement unit it was read in
+    file_rpm: float | None = None   # the speed the file states, when a declared rpm overrides it
 
 
 # --- prepare ---------------------------------------------------------------------------------------
@@ -182,6 +183,7 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
                                  "it needs a vibration channel")
         channel = left[0]
     idx = response_channel(rec, channel)
+    file_rpm = _file_rpm(rec) if rpm is not None else None
     if rpm is None:
         rpm = rec.meta.get("rpm")
         if rpm is None:
@@ -229,7 +231,18 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
     converted = {rec.channels[i].name: rec.channels[i].unit for i in chosen
                  if rec.channels[i].unit and DIFFERENTIATIONS.get(rec.channels[i].quantity, 0)}
     return Job(rec.fs, rpm, rec.channels[idx].name, a, signals, bearing, gear, group, found, band, flags,
-               prewhitening=whitening, mains=mains, quality=quality, converted=converted)
+               prewhitening=whitening, mains=mains, quality=quality, converted=converted, file_rpm=file_rpm)
+
+
+def _file_rpm(rec) -> float | None:
+    """The shaft speed the file itself states (``meta["rpm"]``: CWRU's RPM, MFPT's bearing.rate), when it
+    is a positive number; None otherwise."""
+    v = rec.meta.get("rpm")
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return None
+    return v if np.isfinite(v) and v > 0 else None
 
 
 def _check_prewhitening(value) -> tuple:
