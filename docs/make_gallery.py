@@ -126,7 +126,7 @@ def draw(out: Path) -> list[Path]:
     import tempfile
     with tempfile.TemporaryDirectory() as d:
         vm.synth.fleet(Path(d) / "fleet", n_measurements=20, fault_onset=10)
-        store = Path(d) / "plant.h5"
+        store = Path(d) / "plant.db"
         vm.batch(task="diagnose", store=store, manifest=Path(d) / "fleet" / "machines.csv")
         save(plot.plot_trend(store, asset="pump-3", point="DE", metric="bearing_evidence", baseline_count=6).figure,
              "trend.png")

@@ -57,7 +57,7 @@ def test_the_demo_report_holds_every_section_with_its_numbers(demo_dir):
     assert res["wall"] < 60  # the budget on a 2-core machine
     html, page, text = _parse(d / "report.html")
     for title in ("Ring-down: ringdown_beam.h5", "FRF and modes: hammer_test.h5", "Machine diagnosis: pump_bearing.h5",
-                  "Fleet trends: results.h5", "Provenance"):
+                  "Fleet trends: results.db", "Provenance"):
         assert title in text
     # the synthetic truths: beam 23.7 Hz / zeta 0.012; modes 31, 87, 165 Hz; outer-race fault; pump-3 alarm
     assert re.search(r"fn 23\.7\d* Hz, zeta 0\.012", text)
@@ -130,7 +130,7 @@ def test_vibmeasure_demo_command(tmp_path):
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr[-1500:]
     assert "report:" in r.stdout and (tmp_path / "d" / "report.html").stat().st_size > 100_000
-    assert (tmp_path / "d" / "results.h5").exists()
+    assert (tmp_path / "d" / "results.db").exists()
     again = subprocess.run([sys.executable, "-m", "vibmeasure.cli", "demo", "--out", str(tmp_path / "d")],
                            capture_output=True, text=True, timeout=300)  # inputs reused, stored ones skipped
     assert again.returncode == 0 and "synthesising" not in again.stderr

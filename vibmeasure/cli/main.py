@@ -7,13 +7,13 @@ import sys
 
 from .. import __version__
 from ..core.errors import VibMeasureError
-from . import batch, compare, diagnose, frf, model, oma, report, ringdown, spectrum, srs, trend
+from . import batch, compare, diagnose, frf, model, oma, report, ringdown, spectrum, srs, store, trend
 from ._common import Parser
 
 # command -> module; each module has register(sub) and run(args, out, err); "modes" is frf's second command
 COMMANDS = {"ringdown": ringdown, "spectrum": spectrum, "frf": frf, "modes": frf, "model": model,
             "compare": compare, "diagnose": diagnose, "batch": batch, "trend": trend, "demo": report,
-            "report": report, "srs": srs, "oma": oma}
+            "report": report, "srs": srs, "oma": oma, "store": store}
 
 
 def build_parser() -> Parser:
@@ -21,7 +21,7 @@ def build_parser() -> Parser:
     p = Parser(prog="vibmeasure", description="Vibration measurements to fn, zeta and FRFs you can trust.")
     p.add_argument("--version", action="version", version=f"vibmeasure {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
-    for mod in (ringdown, spectrum, frf, model, compare, diagnose, batch, trend, report, srs, oma):
+    for mod in (ringdown, spectrum, frf, model, compare, diagnose, batch, trend, store, report, srs, oma):
         mod.register(sub)
     return p
 

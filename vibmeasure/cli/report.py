@@ -7,7 +7,7 @@ def register(sub) -> None:
     """Add the command's parser to the subparsers ``sub``."""
     dm = sub.add_parser("demo", help="synthesise demo inputs, analyse them, write an HTML report",
                         description="The main job: a ring-down, a hammer test, a machine with a bearing fault and "
-                                    "a small fleet, analysed into DIR/report.html and DIR/results.h5.")
+                                    "a small fleet, analysed into DIR/report.html and DIR/results.db.")
     dm.add_argument("--out", default="vibmeasure-demo", help="folder for the inputs, report and store "
                                                              "(default vibmeasure-demo)")
     rp = sub.add_parser("report", help="a self-contained HTML report of records and/or a store",

@@ -30,7 +30,13 @@ from ._store_common import STORE_SCHEMA, STORE_VERSION, TABLES, StoreLockedError
 from .store_query import _Queries
 from .store_write import _Writes
 
-__all__ = ["Store", "StoreLockedError", "STORE_SCHEMA", "STORE_VERSION"]
+__all__ = ["Store", "StoreLockedError", "STORE_SCHEMA", "STORE_VERSION", "is_store"]
+
+
+def is_store(obj) -> bool:
+    """Whether ``obj`` is an open store (HDF5 or database) rather than a path or URL to open."""
+    from .sql.store import SQLStore
+    return isinstance(obj, (Store, SQLStore))
 
 class Store(_Queries, _Writes):
     """A condition-monitoring store: assets, points, measurements and results in one HDF5 file.
@@ -48,6 +54,10 @@ class Store(_Queries, _Writes):
         Open for writing (one writer at a time).
     timeout : float
         Seconds to wait for another writer's lock.
+    raw_dir : str or os.PathLike, optional
+        For a database target only (.db, .sqlite, .sqlite3 or a URL such as
+        ``postgresql://user@host/db``, which opens an :class:`~vibmeasure.io.sql.SQLStore` with the
+        same methods): where its raw records are kept.
 
     Raises
     ------
@@ -72,7 +82,18 @@ class Store(_Queries, _Writes):
     ['none']
     """
 
-    def __init__(self, path, *, writable: bool = False, timeout: float = 0.0):
+    def __new__(cls, path=None, *, writable: bool = False, timeout: float = 0.0, raw_dir=None):
+        # a database target (.db/.sqlite/.sqlite3 or a URL) is the same store on SQLite or PostgreSQL
+        from .sql.schema import is_sql_target
+        from .sql.store import SQLStore
+        if cls is Store and path is not None and is_sql_target(path):
+            return SQLStore(path, writable=writable, timeout=timeout, raw_dir=raw_dir)
+        return super().__new__(cls)
+
+    def __init__(self, path, *, writable: bool = False, timeout: float = 0.0, raw_dir=None):
+        if raw_dir is not None:
+            raise ParameterError("raw_dir= is for a database store (.db or a URL): an HDF5 store keeps its raw "
+                                 "records inside its file")
         self.path = Path(path)
         self.writable = bool(writable)
         self._lock_fd = None

@@ -376,7 +376,7 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
     >>> rep["status"].tolist()
     ['done']
     """
-    from ..io.store import Store
+    from ..io.store import Store, is_store
     tasks = _tasks(task)
     items = _expand(inputs) if inputs else []
     if manifest is not None:
@@ -384,7 +384,7 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
     if not items:
         raise ParameterError("no input: give files, folders or globs, or a manifest")
     options = {"fs": fs, "band": band}
-    own = not isinstance(store, Store)
+    own = not is_store(store)
     st = Store(store, writable=True) if own else store
     rows, todo = [], []
     try:

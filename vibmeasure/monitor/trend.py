@@ -88,8 +88,8 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
     ['pump-1', 'pump-2']
     """
     import pandas as pd
-    from ..io.store import Store
-    st = store if isinstance(store, Store) else Store(store)
+    from ..io.store import Store, is_store
+    st = store if is_store(store) else Store(store)
     if isinstance(baseline_count, bool) or not isinstance(baseline_count, (int, np.integer)) or baseline_count < 2:
         raise ParameterError(f"baseline_count={baseline_count!r} must be an integer >= 2")
     rows = []
@@ -197,8 +197,8 @@ def metric_history(store, *, asset: str, point: str, metric: str, task: str | No
     >>> from vibmeasure.monitor.trend import metric_history
     >>> metric_history("missing.h5", asset="a", point="p", metric="nope")  # doctest: +SKIP
     """
-    from ..io.store import Store
-    st = store if isinstance(store, Store) else Store(store)
+    from ..io.store import Store, is_store
+    st = store if is_store(store) else Store(store)
     tasks = [t for t, c, *_ in METRICS if c == metric and (task is None or t == task)]
     if not tasks:
         raise ParameterError(f"metric={metric!r} is not trended; one of {sorted({c for _, c, *_ in METRICS})}")

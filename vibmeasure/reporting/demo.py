@@ -11,7 +11,7 @@ from .html import report
 
 def demo(out_dir="vibmeasure-demo", *, progress=None) -> dict:
     """The main job a newcomer runs: synthesise the demo inputs (if absent) with vm.synth, analyse
-    them, write ``out_dir/report.html`` and ``out_dir/results.h5`` (a Store with the fleet history).
+    them, write ``out_dir/report.html`` and ``out_dir/results.db`` (a Store with the fleet history).
     Returns a short summary (paths, key numbers, seconds). ``progress(message)`` follows the steps."""
     import time
 
@@ -48,8 +48,8 @@ def demo(out_dir="vibmeasure-demo", *, progress=None) -> dict:
     if not (fleet_dir / "machines.csv").exists():
         say("synthesising a small fleet (4 assets, 20 weekly measurements)")
         synth.fleet(fleet_dir, n_measurements=20, fault_onset=10)
-    store = out / "results.h5"
-    say("analysing the fleet into results.h5")
+    store = out / "results.db"
+    say("analysing the fleet into results.db")
     batch(task="diagnose+spectrum", store=store, manifest=fleet_dir / "machines.csv")
     batch(task="ringdown+compare", store=store, manifest=fleet_dir / "structures.csv")
     say("writing report.html")

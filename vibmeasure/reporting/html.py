@@ -137,9 +137,9 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
                          "method": "not analysed"})
     if store is not None:
         try:
-            sections.append(fleet_section(store, Path(store).name if not hasattr(store, "path") else store.path.name))
-            prov.append({"input": Path(store if not hasattr(store, "path") else store.path).name,
-                         "sha256": file_sha256(store if not hasattr(store, "path") else store.path), "method": "trend"})
+            name, digest = _store_provenance(store)
+            sections.append(fleet_section(store, name))
+            prov.append({"input": name, "sha256": digest, "method": "trend"})
         except (VibMeasureError, OSError, ValueError) as exc:
             sections.append(error_section(str(store), exc))
     if not sections:
@@ -153,3 +153,15 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
     with atomic_path(out) as tmp:
         tmp.write_text(html, encoding="utf-8")
     return out
+
+
+def _store_provenance(store) -> tuple[str, str]:
+    """(name, SHA-256) of a store for the report's provenance: a file's own hash; a database server's
+    store is named by its host and database (never its credentials) and has no file to hash."""
+    from ..io.sql import is_sql_target
+    target = getattr(store, "target", None) or getattr(store, "path", None) or store
+    if is_sql_target(target) and "://" in str(target) and not str(target).startswith("sqlite"):
+        return str(target).split("@")[-1].split("://")[-1], "(database server)"
+    path = Path(getattr(store, "path", target))
+    return path.name, file_sha256(path)
+

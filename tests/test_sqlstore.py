@@ -1,0 +1,230 @@
+"""The database store: SQLite by default for a .db file, PostgreSQL for a plant (a real server the tests
+start themselves), the HDF5 store migrated, and both engines held to the HDF5 store's contract."""
+
+import json
+import random
+import signal
+import sqlite3
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+
+import vibmeasure as vm
+from vibmeasure.cli import main as cli_main
+from vibmeasure.io.sql import SQLStore
+
+
+def _fill(st, n=3, raw=True):
+    """One asset, one point, n measurements (raw kept) with one result each; returns the ids."""
+    st.add_asset("pump-1", bearing="6205-2RS", iso_group=2, gear=32, meta={"site": "north"})
+    st.add_point("pump-1", "DE", channel="acc", unit="g")
+    ids = []
+    for i in range(n):
+        rec = vm.Record.from_array(np.arange(500.0) * (i + 1), fs=1000.0, names=["acc"], unit="g")
+        mid = st.add_measurement("pump-1", "DE", time=1.7e9 + 3600 * i, rpm=1500.0 + i, record=rec, keep_raw=raw,
+                                 file=f"r{i}.h5", meta={"i": i})
+        st.add_result(mid, "diagnose", {"top": "none", "i": i}, params={"band": None},
+                      summary={"top": "none", "confidence": 0.5 + 0.1 * i, "v": float("nan") if i == 1 else 1.0})
+        ids.append(mid)
+    return ids
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def target(request, tmp_path):
+    """A new database store's target on each engine."""
+    if request.param == "sqlite":
+        return str(tmp_path / "plant.db"), None
+    return request.getfixturevalue("postgres")(), tmp_path / "raw"
+
+
+def test_the_database_store_keeps_the_hdf5_stores_contract(target, tmp_path):
+    """Everything written reads back exactly as from the HDF5 store: the same frames (asset, point and
+    measurement columns, summary values as columns, NaN kept), the same ids, the raw record sample for
+    sample, the content hash found, read-only refusals."""
+    url, raw_dir = target
+    with vm.Store(tmp_path / "ref.h5", writable=True) as h5:
+        _fill(h5)
+    with vm.Store(url, writable=True, raw_dir=raw_dir) as st:
+        assert isinstance(st, SQLStore)
+        ids = _fill(st)
+        assert st.pending == 8
+    ref, st = vm.Store(tmp_path / "ref.h5"), vm.Store(url, raw_dir=raw_dir)
+    assert ids == ["m0000001", "m0000002", "m0000003"]
+    assert repr(st).endswith("1 assets, 1 points, 3 measurements, 3 results)")
+    for a, b in ((ref.assets(), st.assets()), (ref.points(), st.points())):
+        assert a.to_dict("records") == b.to_dict("records")
+    m_ref, m = ref.measurements(), st.measurements()
+    assert m_ref.drop(columns="time").to_dict("records") == m.drop(columns="time").to_dict("records")
+    assert (m_ref["time"] == m["time"]).all() and str(m["time"].dt.tz) == "UTC"
+    r_ref, r = ref.results("diagnose"), st.results("diagnosis")   # the alias is understood
+    for col in ("measurement", "asset", "point", "top", "confidence", "params", "result"):
+        assert r_ref[col].tolist() == r[col].tolist(), col
+    assert np.isnan(r["v"].iloc[1]) and r["v"].iloc[0] == 1.0
+    assert np.array_equal(st.record("m0000002").data, ref.record("m0000002").data)
+    sha = m["sha256"].iloc[2]
+    assert st.has(sha) == "m0000003" and st.has("0" * 64) is None
+    assert len(st.results("diagnose", since=1.7e9 + 3600, until=1.7e9 + 3600)) == 1
+    assert st.results("nothing").empty and st.errors().empty
+    with pytest.raises(vm.ParameterError, match="open for reading"):
+        st.add_asset("x")
+    with pytest.raises(vm.ParameterError, match="is not in the store"):
+        vm.Store(url, writable=True, raw_dir=raw_dir).add_result("m0000099", "x", {})
+    with vm.Store(url, writable=True, raw_dir=raw_dir) as w:
+        with pytest.raises(vm.ParameterError, match="different description"):
+            w.add_asset("pump-1", bearing="6203-2RS")
+        assert w.add_asset("pump-1", bearing="6205-2RS", iso_group=2, gear=32, meta={"site": "north"}) == "pump-1"
+
+
+def test_sqlite_runs_in_wal_mode_and_readers_see_only_committed_rows(tmp_path):
+    """WAL: a reader opened while a writer holds uncommitted rows reads the last commit, and the writer
+    is not blocked by it; after the commit the same reader object sees the new rows."""
+    p = tmp_path / "plant.db"
+    w = vm.Store(p, writable=True)
+    _fill(w, n=2, raw=False)
+    w.commit()
+    with sqlite3.connect(p) as c:
+        assert c.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
+    w.add_measurement("pump-1", "DE", time=1.8e9)
+    reader = vm.Store(p)
+    assert reader.n_measurements == 2            # the pending third is not visible
+    w.add_measurement("pump-1", "DE", time=1.8e9 + 1)   # the reader does not block the writer
+    w.commit()
+    assert reader.n_measurements == 4
+    w.close()
+
+
+def test_a_database_that_is_not_a_store_is_named(tmp_path):
+    bad = tmp_path / "x.db"
+    bad.write_bytes(b"not a database at all" * 100)
+    with pytest.raises(vm.ParameterError, match="not a readable database"):
+        vm.Store(bad)
+    other = tmp_path / "other.db"
+    with sqlite3.connect(other) as c:
+        c.execute("CREATE TABLE people (name TEXT)")
+    with pytest.raises(vm.ParameterError, match="database of something else"):
+        vm.Store(other, writable=True)
+    with pytest.raises(vm.ParameterError, match="does not exist"):
+        vm.Store(tmp_path / "missing.db")
+    with pytest.raises(vm.ParameterError, match="raw_dir= is for a database store"):
+        vm.Store(tmp_path / "s.h5", writable=True, raw_dir=tmp_path)
+
+
+WRITER = textwrap.dedent("""
+    import sys
+    import numpy as np
+    import vibmeasure as vm
+    st = vm.Store(sys.argv[1], writable=True, timeout=30, raw_dir=sys.argv[2] if len(sys.argv) > 2 else None)
+    st.add_asset("a")
+    st.add_point("a", "p")
+    st.commit()
+    for i in range(100000):
+        mid = st.add_measurement("a", "p", time=1.7e9 + i, record=vm.Record.from_array(np.full(2000, float(i)),
+                                 fs=100.0), keep_raw=True)
+        st.add_result(mid, "x", {"n": i}, summary={"n": i})
+        st.commit()
+        print(mid, flush=True)
+""")
+
+
+def test_kill_9_at_any_moment_loses_no_committed_row(tmp_path):
+    """30 writers of one SQLite store killed at random moments: the store always opens, holds every
+    measurement a writer reported committed, and each holds its result and its raw record."""
+    rng = random.Random(47)
+    p = tmp_path / "s.db"
+    reported = set()
+    for trial in range(30):
+        proc = subprocess.Popen([sys.executable, "-c", WRITER, str(p)], stdout=subprocess.PIPE, text=True)
+        time.sleep(rng.uniform(0.8, 1.8))
+        proc.send_signal(signal.SIGKILL)
+        out, _ = proc.communicate()
+        reported |= set(out.split())
+    st = vm.Store(p)
+    m = st.measurements()
+    assert reported and reported <= set(m["id"])
+    res = st.results("x")
+    assert len(res) == len(m)
+    for mid in m["id"].sample(10, random_state=1):
+        n = int(res.loc[res["measurement"] == mid, "n"].iloc[0])
+        assert np.all(st.record(mid).data == n)
+
+
+def test_concurrent_writers_each_keep_every_row(target, tmp_path):
+    """Four processes write one store at once (50 measurements each, a commit after each): 200 distinct
+    ids, every result beside its measurement. SQLite serialises them (each waits for the others'
+    transactions); PostgreSQL runs them side by side."""
+    url, raw_dir = target
+    script = WRITER.replace("range(100000)", "range(50)")
+    args = [sys.executable, "-c", script, url] + ([str(raw_dir)] if raw_dir else [])
+    procs = [subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(4)]
+    outs = [p.communicate(timeout=300) for p in procs]
+    assert all(p.returncode == 0 for p in procs), [e[-500:] for _, e in outs]
+    ids = [mid for o, _ in outs for mid in o.split()]
+    st = vm.Store(url, raw_dir=raw_dir)
+    assert len(ids) == len(set(ids)) == 200 and set(st.measurements()["id"]) == set(ids)
+    assert len(st.results("x")) == 200 and len(st.assets()) == 1
+
+
+def test_migrate_copies_an_hdf5_store_exactly(target, tmp_path):
+    """`vibmeasure store migrate old.h5 plant.db` (or a PostgreSQL URL): ids, rows and raw records as they
+    were; a target that already holds measurements is refused; the HDF5 store stays readable."""
+    url, raw_dir = target
+    old = tmp_path / "old.h5"
+    with vm.Store(old, writable=True) as st:
+        _fill(st, n=4)
+        st.add_asset("frame-1", kind="structure")
+    argv = ["store", "migrate", str(old), url, "--json"] + (["--raw-dir", str(raw_dir)] if raw_dir else [])
+    out, err = _Buf(), _Buf()
+    assert cli_main(argv, out=out, err=err) == 0, err.text
+    doc = json.loads(out.text)
+    assert (doc["assets"], doc["points"], doc["measurements"], doc["results"], doc["raw"]) == (2, 1, 4, 4, 4)
+    a, b = vm.Store(old), vm.Store(url, raw_dir=raw_dir)
+    assert a.measurements()["id"].tolist() == b.measurements()["id"].tolist()
+    assert a.results("diagnose")["result"].tolist() == b.results("diagnose")["result"].tolist()
+    assert np.array_equal(a.record("m0000004").data, b.record("m0000004").data)
+    with vm.Store(url, writable=True, raw_dir=raw_dir) as w:   # new ids continue after the copied ones
+        assert w.add_measurement("pump-1", "DE", time=2e9) == "m0000005"
+    assert cli_main(argv, out=_Buf(), err=(e := _Buf())) == 2 and "already holds measurements" in e.text
+    out = _Buf()
+    assert cli_main(["store", "info", url], out=out, err=_Buf()) == 0
+    assert "5 measurements" in out.text
+
+
+def test_batch_and_trend_on_a_database_store(tmp_path):
+    """vm.batch writes a .db store as it writes an HDF5 one, re-runs skip what is stored, and vm.trend
+    reads it."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    for i in range(4):
+        vm.write(folder / f"r{i}.h5", vm.synth.machine(rpm=1500.0, fs=12800.0, duration=1.0, seed=i))
+    rep = vm.batch([folder], task="spectrum", store=tmp_path / "s.db")
+    assert (rep["status"] == "done").all() and len(rep) == 4
+    again = vm.batch([folder], task="spectrum", store=tmp_path / "s.db")
+    assert (again["status"] == "skipped").all()
+    assert len(vm.Store(tmp_path / "s.db").results("spectrum")) == 4
+
+
+class _Buf:
+    def __init__(self):
+        self.parts = []
+
+    def write(self, s):
+        self.parts.append(s)
+
+    def flush(self):
+        pass
+
+    def isatty(self):
+        return False
+
+    @property
+    def text(self):
+        return "".join(self.parts)
+
+
+def test_a_postgresql_server_that_cannot_be_reached_is_named():
+    with pytest.raises(vm.ParameterError, match="cannot be used"):
+        vm.Store("postgresql://nobody@127.0.0.1:1/none", timeout=2)

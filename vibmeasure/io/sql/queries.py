@@ -1,0 +1,220 @@
+"""Reading a database store: its tables as DataFrames, a stored record, a content hash's measurement."""
+
+from __future__ import annotations
+
+from ...core.errors import ParameterError
+from .._store_common import TASK_ALIASES, _seconds
+from .schema import _RAW_KEY, _loads, _mid, _mnum, _tables
+
+
+class _SQLQueries:
+    """Methods of :class:`SQLStore` that read; SQLStore inherits them."""
+
+    def _rows(self, stmt) -> list:
+        rows = [dict(r._mapping) for r in self._run(stmt)]
+        self._end_read()
+        return rows
+
+    @property
+    def _assets(self) -> dict:
+        import sqlalchemy as sa
+        out = {}
+        for r in self._rows(sa.select(_tables()["assets"])):
+            out[r["asset"]] = dict(r, gear=_loads(r["gear"]), meta=_loads(r["meta"]) or {})
+        return out
+
+    @property
+    def _points(self) -> dict:
+        import sqlalchemy as sa
+        return {(r["asset"], r["point"]): r for r in self._rows(sa.select(_tables()["points"]))}
+
+    def assets(self):
+        """Assets as a DataFrame (asset, kind, bearing, gear, model, iso_group, foundation, meta).
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> with vm.Store(pathlib.Path(tempfile.mkdtemp()) / "p.db", writable=True) as st:
+        ...     _ = st.add_asset("fan-3", iso_group=1)
+        ...     st.assets()["iso_group"].tolist()
+        [1]
+        """
+        import pandas as pd
+        cols = ["asset", "kind", "bearing", "gear", "model", "iso_group", "foundation", "meta"]
+        rows = list(self._assets.values())
+        return pd.DataFrame(rows, columns=cols) if rows else pd.DataFrame(columns=cols)
+
+    def points(self, asset: str | None = None):
+        """Measurement points as a DataFrame (asset, point, channel, direction, unit).
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> with vm.Store(pathlib.Path(tempfile.mkdtemp()) / "p.db", writable=True) as st:
+        ...     _ = st.add_asset("fan-3"); _ = st.add_point("fan-3", "DE", unit="g")
+        ...     st.points("fan-3")["unit"].tolist()
+        ['g']
+        """
+        import pandas as pd
+        import sqlalchemy as sa
+        t = _tables()["points"]
+        stmt = sa.select(t) if asset is None else sa.select(t).where(t.c.asset == asset)
+        cols = ["asset", "point", "channel", "direction", "unit"]
+        rows = self._rows(stmt.order_by(t.c.asset, t.c.point))
+        return pd.DataFrame(rows, columns=cols) if rows else pd.DataFrame(columns=cols)
+
+    def _where(self, stmt, t, asset, point, since, until):
+        if asset is not None:
+            stmt = stmt.where(t.c.asset == asset)
+        if point is not None:
+            stmt = stmt.where(t.c.point == point)
+        if since is not None:
+            stmt = stmt.where(t.c.time >= _seconds(since))
+        if until is not None:
+            stmt = stmt.where(t.c.time <= _seconds(until))
+        return stmt.order_by(t.c.time, t.c.id)
+
+    def measurements(self, asset: str | None = None, point: str | None = None, since=None, until=None):
+        """Measurements as a DataFrame, oldest first; ``time`` as UTC Timestamps (``Store.measurements``).
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> with vm.Store(pathlib.Path(tempfile.mkdtemp()) / "p.db", writable=True) as st:
+        ...     _ = st.add_asset("fan-3"); _ = st.add_point("fan-3", "DE")
+        ...     _ = st.add_measurement("fan-3", "DE", time="2026-11-28T08:00", rpm=1480)
+        ...     st.measurements("fan-3")["rpm"].tolist()
+        [1480.0]
+        """
+        import pandas as pd
+        import sqlalchemy as sa
+        t = _tables()["measurements"]
+        rows = self._rows(self._where(sa.select(t), t, asset, point, since, until))
+        cols = ["id", "asset", "point", "time", "rpm", "sha256", "file", "raw", "meta"]
+        if not rows:
+            return pd.DataFrame(columns=cols)
+        for r in rows:
+            r["id"] = _mid(r["id"])
+            r["raw"] = r["raw"] is not None
+            r["meta"] = _loads(r["meta"]) or {}
+        df = pd.DataFrame(rows, columns=cols)
+        df["time"] = pd.to_datetime(df["time"], unit="s", utc=True)
+        return df
+
+    def results(self, task: str, asset: str | None = None, point: str | None = None, since=None, until=None):
+        """Results of one task as a DataFrame, oldest first (``Store.results``): measurement, asset, point,
+        time, task, version, params, the summary values as columns and ``result``.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> with vm.Store(pathlib.Path(tempfile.mkdtemp()) / "p.db", writable=True) as st:
+        ...     _ = st.add_asset("fan-3"); _ = st.add_point("fan-3", "DE")
+        ...     mid = st.add_measurement("fan-3", "DE", time=0.0)
+        ...     st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none", "confidence": 0.9})
+        ...     st.results("diagnose")["confidence"].tolist()
+        [0.9]
+        """
+        import pandas as pd
+        import sqlalchemy as sa
+        t = _tables()
+        r, m = t["results"], t["measurements"]
+        task = TASK_ALIASES.get(task, task)
+        stmt = (sa.select(r.c.measurement, m.c.asset, m.c.point, m.c.time, r.c.task, r.c.version, r.c.params,
+                          r.c.summary, r.c.result, m.c.id).join(m, r.c.measurement == m.c.id)
+                .where(r.c.task == task))
+        stmt = self._where(stmt, m, asset, point, since, until).order_by(r.c.id)
+        base = ["measurement", "asset", "point", "time", "task", "version", "params"]
+        flat = [{"measurement": _mid(x["measurement"]), "asset": x["asset"], "point": x["point"], "time": x["time"],
+                 "task": x["task"], "version": x["version"], "params": _loads(x["params"]) or {},
+                 **(_loads(x["summary"]) or {}), "result": _loads(x["result"])} for x in self._rows(stmt)]
+        if not flat:
+            return pd.DataFrame(columns=base)
+        df = pd.DataFrame(flat)
+        df["time"] = pd.to_datetime(df["time"], unit="s", utc=True)
+        return df
+
+    def errors(self):
+        """Inputs a batch could not analyse: measurement, file and the error message (``Store.errors``).
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> with vm.Store(pathlib.Path(tempfile.mkdtemp()) / "p.db", writable=True) as st:
+        ...     len(st.errors())
+        0
+        """
+        return self.results("error")
+
+    def has(self, sha256: str) -> str | None:
+        """The measurement id stored for a content hash, or None (the latest if several).
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> with vm.Store(pathlib.Path(tempfile.mkdtemp()) / "p.db", writable=True) as st:
+        ...     st.has("0" * 64) is None
+        True
+        """
+        import sqlalchemy as sa
+        if not isinstance(sha256, str) or not sha256:
+            return None
+        m = _tables()["measurements"]
+        n = self._run(sa.select(sa.func.max(m.c.id)).where(m.c.sha256 == sha256)).scalar_one_or_none()
+        self._end_read()
+        return None if n is None else _mid(n)
+
+    def _known(self, measurement) -> bool:
+        import sqlalchemy as sa
+        n = _mnum(measurement)
+        if n is None:
+            return False
+        m = _tables()["measurements"]
+        return bool(self._rows(sa.select(m.c.id).where(m.c.id == n)))
+
+    @property
+    def n_measurements(self) -> int:
+        """Measurements in the store, committed or pending."""
+        import sqlalchemy as sa
+        n = self._run(sa.select(sa.func.count()).select_from(_tables()["measurements"])).scalar_one()
+        self._end_read()
+        return int(n)
+
+    def record(self, measurement: str):
+        """The raw record stored with a measurement (``keep_raw=True``), read from its content-addressed file.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> with vm.Store(pathlib.Path(tempfile.mkdtemp()) / "p.db", writable=True) as st:
+        ...     _ = st.add_asset("fan-3"); _ = st.add_point("fan-3", "DE")
+        ...     rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
+        ...     mid = st.add_measurement("fan-3", "DE", time=0.0, record=rec, keep_raw=True)
+        ...     st.record(mid).n_samples
+        12000
+        """
+        import sqlalchemy as sa
+
+        from ..hdf5 import read_hdf5
+        n = _mnum(measurement)
+        m = _tables()["measurements"]
+        rows = [] if n is None else self._rows(sa.select(m.c.raw).where(m.c.id == n))
+        if not rows:
+            raise ParameterError(f"measurement={measurement!r} is not in store {self.target!r}")
+        key = rows[0]["raw"]
+        if key is None:
+            raise ParameterError(f"measurement {measurement!r} was stored without its raw record")
+        if not _RAW_KEY.match(str(key)) or self.raw_dir is None:
+            raise ParameterError(f"measurement {measurement!r}: its raw record's name {key!r} is not a content "
+                                 "hash, or the store has no raw_dir")
+        path = self.raw_dir / key[:2] / f"{key}.h5"
+        if not path.is_file():
+            raise ParameterError(f"measurement {measurement!r}: its raw record {str(path)!r} is missing")
+        return read_hdf5(path)
