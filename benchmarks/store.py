@@ -1,9 +1,13 @@
-"""The store's cost per commit as it grows: 20,000 small diagnosis results in commits of 50 (issue 47).
+"""The store's cost as it grows (issue 47): commit time from 1,000 to N results, and the query a trend
+makes (one asset's year of results).
 
-The HDF5 store copies and seals its whole file on every commit, so its commit time grows with the file;
-a database appends rows in a transaction. Printed per engine: the mean time of a commit (50 measurements
-with one result each) over the first and the last 10 commits, and the whole run's wall time. PostgreSQL
-is run when a URL is given (an empty database; the tests start a throw-away cluster the same way).
+A plant of ASSETS machines measured hourly: each commit adds 50 measurements with one diagnosis result
+each. Printed per engine at 1k, 10k, 100k, ... results: the mean time of 10 commits there, the time of
+``results("diagnose", asset=..., since=..., until=...)`` over one asset's year and of ``vm.trend`` on
+that asset. The HDF5 store copies and seals its whole file on every commit, so it is run only up to
+20,000 results; a database appends rows in a transaction. PostgreSQL is run when a URL of an empty
+database is given (the tests start a throw-away cluster the same way). Targets: commit cost flat
+(last / first <= 3), the year's query under 0.2 s.
 
     python benchmarks/store.py [N_RESULTS] [--postgres postgresql://user@127.0.0.1:PORT/db]
 """
@@ -16,43 +20,59 @@ from pathlib import Path
 import vibmeasure as vm
 
 PER_COMMIT = 50
+ASSETS = 100
+HOUR = 3600.0
+T0 = 1.7e9
 
 
-def run(target, n: int, raw_dir=None) -> tuple[float, float, float]:
-    """(ms per commit over the first 10, ms over the last 10, total s) for n results."""
-    times = []
-    t_all = time.perf_counter()
+def run(target, n: int, raw_dir=None) -> list:
+    """[(results so far, ms per commit over 10 commits, year query s, trend s)] at each checkpoint."""
+    marks = [m for m in (1000, 10_000, 100_000, 1_000_000, 10_000_000) if m <= n]
+    out = []
     with vm.Store(target, writable=True, **({"raw_dir": raw_dir} if raw_dir else {})) as st:
-        st.add_asset("pump-1", bearing="6205-2RS")
-        st.add_point("pump-1", "DE", unit="g")
+        for a in range(ASSETS):
+            st.add_asset(f"pump-{a:03d}", bearing="6205-2RS")
+            st.add_point(f"pump-{a:03d}", "DE", unit="g")
         st.commit()
-        for c in range(n // PER_COMMIT):
+        k, times = 0, []
+        while k < n:
             t0 = time.perf_counter()
-            for i in range(PER_COMMIT):
-                k = c * PER_COMMIT + i
-                mid = st.add_measurement("pump-1", "DE", time=1.7e9 + 60 * k, rpm=1480.0, sha256=f"{k:064x}")
-                st.add_result(mid, "diagnose", {"top": "none", "confidence": 0.9, "faults": [k] * 20},
-                              summary={"top": "none", "confidence": 0.9, "velocity_rms_mm_s": 1.2})
+            for _ in range(PER_COMMIT):
+                asset, hour = f"pump-{k % ASSETS:03d}", k // ASSETS
+                mid = st.add_measurement(asset, "DE", time=T0 + HOUR * hour, rpm=1480.0, sha256=f"{k:064x}")
+                st.add_result(mid, "diagnose", {"top": "none", "confidence": 0.9},
+                              summary={"top": "none", "confidence": 0.9, "velocity_rms_mm_s": 1.2 + 1e-4 * (k % 7),
+                                       "zone": "A", "bearing_evidence": 1.0})
+                k += 1
             st.commit()
             times.append(time.perf_counter() - t0)
-    total = time.perf_counter() - t_all
-    return 1e3 * sum(times[:10]) / 10, 1e3 * sum(times[-10:]) / 10, total
+            if marks and k >= marks[0]:
+                ms = 1e3 * sum(times[-10:]) / len(times[-10:])
+                year = min(8760.0, k / ASSETS)
+                t1 = time.perf_counter()
+                df = st.results("diagnose", asset="pump-000", since=T0, until=T0 + HOUR * year)
+                q = time.perf_counter() - t1
+                t1 = time.perf_counter()
+                vm.trend(st, asset="pump-000")
+                tr = time.perf_counter() - t1
+                out.append((marks.pop(0), ms, q, tr, len(df)))
+    return out
 
 
 def main(argv):
-    n = int(argv[0]) if argv and argv[0].isdigit() else 20000
+    n = int(argv[0]) if argv and argv[0].isdigit() else 100_000
     pg = argv[argv.index("--postgres") + 1] if "--postgres" in argv else None
     d = Path(tempfile.mkdtemp())
-    rows = [("HDF5 (.h5)", run(d / "s.h5", n)), ("SQLite (.db, WAL)", run(d / "s.db", n))]
+    engines = [("HDF5 (.h5)", d / "s.h5", min(n, 20_000), None), ("SQLite (.db, WAL)", d / "s.db", n, None)]
     if pg:
-        rows.append(("PostgreSQL", run(pg, n, raw_dir=d / "raw")))
-    print(f"{n} results in commits of {PER_COMMIT} (one measurement + one result each)\n")
-    print(f"{'engine':20s} {'first 10 commits':>17s} {'last 10 commits':>16s} {'total':>9s}")
-    for name, (first, last, total) in rows:
-        print(f"{name:20s} {first:14.1f} ms {last:13.1f} ms {total:7.1f} s")
-    h5_last = rows[0][1][1]
-    for name, (_, last, _) in rows[1:]:
-        print(f"last-commit ratio HDF5 / {name}: {h5_last / last:.1f}x")
+        engines.append(("PostgreSQL", pg, n, d / "raw"))
+    print(f"{ASSETS} assets measured hourly, commits of {PER_COMMIT} measurements with one result each\n")
+    print(f"{'engine':20s} {'results':>9s} {'ms/commit':>10s} {'year query':>11s} {'trend':>8s} {'rows':>6s}")
+    for name, target, m, raw in engines:
+        rows = run(target, m, raw)
+        for k, ms, q, tr, nrows in rows:
+            print(f"{name:20s} {k:9d} {ms:10.1f} {q:9.3f} s {tr:6.3f} s {nrows:6d}")
+        print(f"{name:20s} commit cost last / first: {rows[-1][1] / rows[0][1]:.2f}\n", flush=True)
 
 
 if __name__ == "__main__":

@@ -1,9 +1,11 @@
 """Condition monitoring across a fleet: the measurement store, batch analysis (serial and on a real
 Dask LocalCluster), trends and alarms."""
 
+import io
 import json
 import os
 import random
+import re
 import signal
 import subprocess
 import sys
@@ -238,10 +240,63 @@ def test_batch_skips_what_is_stored_and_lists_bad_files(tmp_path):
     diag = vm.Store(tmp_path / "s.h5").results("diagnose")
     assert list(diag["top"][diag["asset"] == "m0"]) == ["bearing_outer_race"]  # r000: the faulty one
     again = vm.batch(task="spectrum+diagnose", store=tmp_path / "s.h5", manifest=man)
-    assert list(again["status"]).count("skipped") == 7  # same content: not analysed twice
-    assert "it failed then: " in again.loc[again["file"].str.endswith("broken.h5"), "message"].iloc[0]
+    assert list(again["status"]).count("skipped") == 6  # same content, every task done: not analysed twice
+    # an input that failed is tried again (it is still broken: a second error, no second measurement)
+    assert again.loc[again["file"].str.endswith("broken.h5"), "status"].iloc[0] == "error"
     forced = vm.batch(task="spectrum", store=tmp_path / "s.h5", manifest=man, force=True)
     assert list(forced["status"]).count("done") == 6
+    # force re-analyses into the measurements already stored: 7 measurements, not 14 or 21
+    assert vm.Store(tmp_path / "s.h5").n_measurements == 7
+    spec = vm.Store(tmp_path / "s.h5").results("spectrum")   # the re-analysis replaces the first
+    assert len(spec) == 6 and spec["measurement"].nunique() == 6
+
+
+def test_a_failed_input_is_analysed_again_once_its_manifest_is_fixed(tmp_path, shared_data):
+    """No rpm in the manifest and none in the file: diagnose fails and is stored as an error; with the
+    rpm added to the manifest a re-run analyses it (into the same measurement) instead of skipping it."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    rec = vm.synth.machine(fault="bearing_outer_race", rpm=1500.0, fs=12800.0, duration=1.0, seed=3)
+    vm.write(folder / "a.h5", vm.Record(rec.data, rec.fs, rec.channels))   # the speed left out of the file
+    (folder / "m.csv").write_text("file,asset,point,bearing\na.h5,m1,DE,6205-2RS\n")
+    first = vm.batch(task="diagnose", store=tmp_path / "s.db", manifest=folder / "m.csv")
+    assert first["status"].tolist() == ["error"] and "shaft speed" in first["message"].iloc[0]
+    (folder / "m.csv").write_text("file,asset,point,bearing,rpm\na.h5,m1,DE,6205-2RS,1500\n")
+    second = vm.batch(task="diagnose", store=tmp_path / "s.db", manifest=folder / "m.csv")
+    assert second["status"].tolist() == ["done"]
+    st = vm.Store(tmp_path / "s.db")
+    assert st.n_measurements == 1 and st.results("diagnose")["top"].tolist() == ["bearing_outer_race"]
+    assert st.errors().empty   # the error is replaced by the new outcome
+    third = vm.batch(task="diagnose", store=tmp_path / "s.db", manifest=folder / "m.csv")
+    assert third["status"].tolist() == ["skipped"]
+
+
+def test_files_and_a_manifest_and_sensors_by_channel(tmp_path):
+    """A file given both as an input and in the manifest is analysed once, with the manifest's metadata;
+    a row listed twice once. Two rows of one file on different channels are two points, each diagnosed
+    from its own sensor only (a fault on one channel is not the other point's). A folder whose files
+    carry time stamps for names (no readable suffix) is read; a row's unit and fs apply."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    bad = vm.synth.machine(fault="bearing_outer_race", rpm=1500.0, fs=12800.0, duration=2.0, seed=5)
+    good = vm.synth.machine(fault="none", rpm=1500.0, fs=12800.0, duration=2.0, seed=6)
+    two = vm.Record.from_array(np.vstack([bad.data[0], good.data[0]]), fs=bad.fs, names=["de", "nde"], unit="g")
+    vm.write(folder / "two.h5", two)
+    (folder / "m.csv").write_text("file,asset,point,channel,rpm,bearing\n"
+                                  "two.h5,pump,DE,de,1500,6205-2RS\ntwo.h5,pump,NDE,nde,1500,6205-2RS\n"
+                                  "two.h5,pump,NDE,nde,1500,6205-2RS\n")
+    rep = vm.batch([folder / "two.h5"], task="diagnose", store=tmp_path / "s.db", manifest=folder / "m.csv")
+    assert rep["status"].tolist().count("done") == 2 and "listed twice" in " ".join(rep["message"].fillna(""))
+    d = vm.Store(tmp_path / "s.db").results("diagnose").set_index("point")
+    assert d.loc["DE", "top"] == "bearing_outer_race" and d.loc["NDE", "top"] == "none"
+    stamped = tmp_path / "ims"
+    stamped.mkdir()
+    np.savetxt(stamped / "2004.02.12.10.32.39", good.data[0][:4096, None], delimiter="\t")
+    (stamped / "rows.csv").write_text("file,asset,fs,unit\n2004.02.12.10.32.39,rig,12800,g\n")
+    found = vm.batch([stamped], task="spectrum", store=tmp_path / "s2.db", manifest=stamped / "rows.csv")
+    assert found["status"].tolist() == ["done"], found["message"].tolist()
+    r = vm.Store(tmp_path / "s2.db").results("spectrum")
+    assert r["result"].iloc[0]["unit"].startswith("g")
 
 
 def test_manifest_rules(tmp_path):
@@ -352,3 +407,73 @@ def test_trend_command_and_plot(fleet_store, tmp_path):
                 err=io.StringIO()) == 0
     doc = json.loads(out.getvalue())
     assert doc["assets"]["pump-3"] == "alarm" and (tmp_path / "t.png").stat().st_size > 10_000
+
+
+def test_trend_lists_every_asset_and_judges_a_fault_present_from_the_start(tmp_path):
+    """No asset is left out: one with fewer measurements than the baseline needs reads "too few" (with
+    its ISO zone where it is C or D). An asset diagnosed with an inner-race fault at 1.00 on every
+    record is an alarm whatever its baseline (the baseline holds the fault). A warm-up slope over a few
+    hours is not extrapolated weeks ahead. A measurement analysed twice counts once."""
+    p = tmp_path / "s.db"
+    t0 = 1.7e9
+    with vm.Store(p, writable=True) as st:
+        for a in ("faulty", "new", "zone-d", "warm"):
+            st.add_asset(a)
+            st.add_point(a, "DE")
+
+        def diag(a, t, top, conf, v, zone="A"):
+            mid = st.add_measurement(a, "DE", time=t)
+            st.add_result(mid, "diagnose", {}, summary={"top": top, "confidence": conf, "velocity_rms_mm_s": v,
+                                                       "zone": zone, "bearing_evidence": 1.0})
+            return mid
+        for k in range(12):
+            mid = diag("faulty", t0 + 86400 * k, "bearing_inner_race", 1.0, 1.0 + 0.01 * (k % 3))
+        st.add_result(mid, "diagnose", {}, summary={"top": "bearing_inner_race", "confidence": 1.0,
+                                                   "velocity_rms_mm_s": 1.0, "zone": "A", "bearing_evidence": 1.0})
+        diag("new", t0, "none", 0.9, 1.0)
+        diag("zone-d", t0, "none", 0.9, 12.0, "D")
+        diag("zone-d", t0 + 60, "none", 0.9, 12.5, "D")
+        # 8 steady then a slow rise over 4.6 hours, within its limits
+        for k in range(14):
+            v = 2.0 + 0.002 * (k % 2) + (0.01 * (k - 7) if k >= 8 else 0.0)
+            diag("warm", t0 + 1200 * k, "none", 0.95, v)
+    tr = vm.trend(p, baseline_count=8)
+    assets = tr.attrs["assets"]
+    assert set(assets) == {"faulty", "new", "zone-d", "warm"}
+    assert assets["faulty"] == "alarm" and assets["new"] == "no baseline yet" and assets["zone-d"] == "alarm"
+    assert assets["warm"] == "ok", tr[tr.asset == "warm"][["metric", "verdict", "reason"]].to_string()
+    row = tr[(tr.asset == "faulty") & (tr.metric == "diagnosis")].iloc[0]
+    assert "bearing_inner_race named at 1.00 in the last two" in row.reason
+    vel = tr[(tr.asset == "faulty") & (tr.metric == "velocity_rms_mm_s")].iloc[0]
+    assert vel["n"] == 12   # the measurement with two results counts once
+    assert tr[(tr.asset == "warm") & (tr.metric == "velocity_rms_mm_s")]["alarm_date"].isna().all()
+
+
+def test_cli_batch_fails_when_every_input_failed_and_ctrl_c_is_one_line(tmp_path):
+    """`vibmeasure batch` exits 1 when an input failed (the JSON document still lists the errors);
+    Ctrl-C ends it with exit 130 and one line ("interrupted: N of M stored"), no traceback, the store
+    readable and holding what was stored."""
+    from vibmeasure.cli import main as cli_main
+    (tmp_path / "a.csv").write_text("not,a,record\n")
+    out, err = io.StringIO(), io.StringIO()
+    code = cli_main(["batch", str(tmp_path / "a.csv"), "--store", str(tmp_path / "s.db"), "--task", "spectrum",
+                     "--json"], out=out, err=err)
+    assert code == 1 and "1 of 1 input(s) failed" in err.getvalue()
+    assert json.loads(out.getvalue())["counts"] == {"error": 1}
+    folder = tmp_path / "many"
+    folder.mkdir()
+    for i in range(40):
+        vm.write(folder / f"r{i:02d}.h5", vm.synth.machine(rpm=1500.0, fs=12800.0, duration=8.0, seed=i))
+    proc = subprocess.Popen([sys.executable, "-m", "vibmeasure", "batch", str(folder), "--store",
+                             str(tmp_path / "big.db"), "--task", "diagnose"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not (tmp_path / "big.db").exists() and time.monotonic() < deadline:   # the batch has begun
+        time.sleep(0.2)
+    time.sleep(2.0)
+    assert proc.poll() is None, "the batch ended before it could be interrupted"
+    proc.send_signal(signal.SIGINT)
+    _, errs = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "Traceback" not in errs, errs[-800:]
+    n = int(re.search(r"interrupted: (\d+) of 40 stored", errs).group(1))
+    assert vm.Store(tmp_path / "big.db").n_measurements == n   # what it said it stored is there

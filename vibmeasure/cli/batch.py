@@ -11,8 +11,10 @@ def register(sub) -> None:
                         description="Analyse files, folders and globs (and/or a manifest CSV) into a vm.Store; "
                                     "inputs already in the store are skipped.")
     bt.add_argument("inputs", nargs="*", help="files, folders or globs")
-    bt.add_argument("--store", required=True, help="the store (.h5), created when missing")
-    bt.add_argument("--manifest", help="CSV: file, asset, point, channel, rpm, bearing, model, time")
+    bt.add_argument("--store", required=True, help="the store: a .db file (SQLite), a postgresql:// URL or an .h5 "
+                                                   "file; created when missing")
+    bt.add_argument("--manifest", help="CSV: file, asset, point, channel, rpm, bearing, model, time, unit, fs, "
+                                       "tach, pulses_per_rev")
     bt.add_argument("--task", default="diagnose",
                     help="ringdown, modes, spectrum, diagnose, compare, or several joined by + (default diagnose)")
     bt.add_argument("--workers", type=int, help="local Dask cluster with this many worker processes")
@@ -24,14 +26,17 @@ def register(sub) -> None:
 
 
 def run(args, out, err) -> int:
-    """Analyse the inputs into the store (a tqdm bar on stderr), then count what was done."""
+    """Analyse the inputs into the store (a tqdm bar on stderr), then count what was done. Exit 0 when
+    every input was analysed or skipped as already stored, 1 when any failed, 130 on Ctrl-C."""
     from tqdm import tqdm
 
     from ..monitor.batch import batch
     bar = None
+    seen = [0, 0]   # inputs stored, inputs to analyse
 
     def progress(done, total):
         nonlocal bar
+        seen[:] = [done, total]
         if bar is None:
             bar = tqdm(total=total, unit="file", file=err, disable=None, leave=False)
         bar.update(done - bar.n)
@@ -39,6 +44,12 @@ def run(args, out, err) -> int:
         rep = batch(args.inputs, task=args.task, store=args.store, manifest=args.manifest, workers=args.workers,
                     scheduler=args.scheduler, force=args.force, keep_raw=args.keep_raw, fs=args.fs,
                     progress=progress)
+    except KeyboardInterrupt:   # the batch commits what it stored before it lets go of the store
+        if bar is not None:
+            bar.close()
+            bar = None
+        print(f"vibmeasure: interrupted: {seen[0]} of {seen[1]} stored", file=err)
+        return 130
     finally:
         if bar is not None:
             bar.close()
@@ -52,4 +63,7 @@ def run(args, out, err) -> int:
               f"{counts.get('error', 0)} with errors", file=out)
         for _, r in errors.iterrows():
             print(f"  {r['file']}: {r['message']}", file=out)
+    if len(errors):   # 0 only when every input was analysed or skipped as already stored
+        print(f"vibmeasure: {len(errors)} of {len(rep)} input(s) failed", file=err)
+        return 1
     return 0

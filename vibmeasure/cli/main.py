@@ -54,6 +54,9 @@ def main(argv=None, *, out=None, err=None) -> int:
         return COMMANDS[args.command].run(args, out, err)
     except BrokenPipeError:  # the reader of our output went away (| head)
         return 0
+    except KeyboardInterrupt:   # Ctrl-C: said in one line; what a store committed before it stays
+        print("vibmeasure: interrupted", file=err)
+        return 130
     except (VibMeasureError, OSError) as exc:
         print(f"vibmeasure: error: {exc}", file=err)
         return 2

@@ -12,7 +12,7 @@ def register(sub) -> None:
     """Add the command's parser to the subparsers ``sub``."""
     tr = sub.add_parser("trend", help="trends, limits and verdicts per asset and point of a store",
                         description="Baseline, watch/alarm limits, trend slope and verdict per metric.")
-    tr.add_argument("store", help="the store (.h5)")
+    tr.add_argument("store", help="the store: a .db file, a postgresql:// URL or an .h5 file")
     tr.add_argument("--asset", help="only this asset (default: all)")
     tr.add_argument("--point", help="only this measurement point (default: all)")
     tr.add_argument("--baseline", type=int, default=8, help="measurements in the baseline (default 8)")
@@ -37,9 +37,10 @@ def run(args, out, err) -> int:
             for _, r in tr[tr["asset"] == a].iterrows():
                 print(f"  {r['point']:<10} {r['metric']:<20} {r['verdict']:<6} {r['reason']}", file=out)
     if args.plot:
-        if tr.empty:
-            raise VibMeasureError("nothing to plot: no trended metric")
-        r = tr.iloc[0]
+        drawn = tr[tr["baseline_mean"].notna()]   # rows with a baseline to draw against
+        if drawn.empty:
+            raise VibMeasureError("nothing to plot: no metric has a baseline yet")
+        r = drawn.iloc[0]
         ax = plot_module().plot_trend(args.store, asset=r["asset"], point=r["point"], metric=r["metric"],
                                       task=r["task"], baseline_count=args.baseline)
         save_figure(ax.figure, args.plot)

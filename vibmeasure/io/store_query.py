@@ -161,7 +161,8 @@ class _Queries:
         -------
         pandas.DataFrame
             measurement, asset, point, time, task, version, params, the summary values as columns and
-            ``result`` (the full result, a dict).
+            ``result`` (the full result, a dict); one row per measurement, its latest result of the task
+            (a re-analysis replaces the earlier one).
 
         Raises
         ------
@@ -199,6 +200,8 @@ class _Queries:
         df = pd.DataFrame(flat)
         if df.empty:
             return pd.DataFrame(columns=["measurement", "asset", "point", "time", "task", "version", "params"])
+        # a measurement analysed again: its latest result of the task replaces the earlier ones
+        df = df.drop_duplicates("measurement", keep="last")
         for k, v in (("asset", asset), ("point", point)):
             if v is not None:
                 df = df[df[k] == v]
@@ -231,7 +234,15 @@ class _Queries:
         >>> len(st.errors())
         0
         """
-        return self.results("error")
+        df = self.results("error")
+        if df.empty:
+            return df
+        # an error a later analysis of the same measurement succeeded past is no longer an error
+        last_error, last_ok = {}, {}
+        for i, r in enumerate(self._each("results")):
+            (last_error if r["task"] == "error" else last_ok)[r["measurement"]] = i
+        keep = [last_error[m] > last_ok.get(m, -1) for m in df["measurement"]]
+        return df[keep].reset_index(drop=True)
 
     @staticmethod
     def _timed(df, since, until):

@@ -1,12 +1,16 @@
 """Batch analysis into a measurement store, serially or on a Dask cluster.
 
 Inputs are files, folders and globs, with an optional manifest (CSV: ``file`` (name or glob relative
-to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``model``, ``time``, and for a
-speed that varies ``tach`` (the tachometer channel) and ``pulses_per_rev``).
+to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``model``, ``time``, ``unit`` and
+``fs`` (for files that do not state them), and for a speed that varies ``tach`` (the tachometer channel)
+and ``pulses_per_rev``). A manifest row's ``channel`` is the point's sensor: the only one analysed.
 Each input is read and analysed by a pure function (:func:`analyse_file`) that returns plain data;
 with Dask the workers run it and only the client writes the store, committing every few dozen
-results. One bad file never stops the batch: its error is stored and listed. Inputs whose content
-hash is already in the store are skipped unless ``force=True``.
+results. One bad file never stops the batch: its error is stored and listed. An input whose content
+is already stored at its asset and point with a result of every task asked is skipped unless
+``force=True``; one whose analysis failed is analysed again; either way a re-analysis adds results
+to the measurement already stored, never a second measurement of the same content. A file a manifest
+names is analysed once, with the manifest's metadata, even when it is also given as an input.
 """
 
 from __future__ import annotations
@@ -27,7 +31,8 @@ from ..io._common import file_sha256
 __all__ = ["batch", "read_manifest", "analyse_file", "TASKS", "MANIFEST_COLUMNS"]
 
 TASKS = ("ringdown", "modes", "spectrum", "diagnose", "compare")
-MANIFEST_COLUMNS = ("file", "asset", "point", "channel", "rpm", "bearing", "model", "time", "tach", "pulses_per_rev")
+MANIFEST_COLUMNS = ("file", "asset", "point", "channel", "rpm", "bearing", "model", "time", "tach", "pulses_per_rev",
+                    "unit", "fs")
 READABLE = (".csv", ".txt", ".h5", ".hdf5", ".wav", ".mat", ".lvm", ".uff", ".unv")
 COMMIT_EVERY = 50       # inputs per commit (each commit rewrites the store: see io/store.py)
 MAX_PER_TASK = 8        # inputs per Dask task at most (fewer when the batch is small: every worker keeps busy)
@@ -58,7 +63,7 @@ def read_manifest(path) -> list[dict]:
     ----------
     path : str or os.PathLike
         The manifest: columns file, asset, point, channel, rpm, bearing, model, time, tach,
-        pulses_per_rev (any other column is an error).
+        pulses_per_rev, unit, fs (any other column is an error).
 
     Returns
     -------
@@ -105,6 +110,11 @@ def read_manifest(path) -> list[dict]:
                     row["rpm"] = float(row["rpm"])
                 except ValueError:
                     raise ParameterError(f"manifest {str(path)!r} line {i}: rpm={row['rpm']!r} is not a number") from None
+            if row.get("fs"):
+                try:
+                    row["fs"] = float(row["fs"])
+                except ValueError:
+                    raise ParameterError(f"manifest {str(path)!r} line {i}: fs={row['fs']!r} is not a number") from None
             if row.get("pulses_per_rev"):
                 try:
                     row["pulses_per_rev"] = int(row["pulses_per_rev"])
@@ -129,13 +139,40 @@ def _expand(inputs) -> list[dict]:
             if not hits:
                 raise ParameterError(f"input {s!r} matches no file")
         elif os.path.isdir(s):
-            hits = sorted(str(q) for q in Path(s).rglob("*") if q.suffix.lower() in READABLE and q.is_file())
+            hits = sorted(str(q) for q in Path(s).rglob("*") if _data_name(q) and q.is_file())
         elif os.path.isfile(s):
-            hits = [s]
+            items.append({"file": s})   # a file named by the user is read whatever its name
+            continue
         else:
             raise ParameterError(f"input {s!r} is not a file, folder or glob")
-        items += [{"file": h} for h in hits if Path(h).suffix.lower() in READABLE]
+        items += [{"file": h} for h in hits if _data_name(Path(h))]
     return items
+
+
+def _data_name(p: Path) -> bool:
+    """Whether a file found in a folder or by a glob is a record to read: a readable suffix, or none
+    at all, or a numeric one (rigs that name files by their time stamp, "2004.02.12.10.32.39");
+    never a hidden file (a store's lock, a writer's temporary file)."""
+    suffix = p.suffix.lower()
+    return not p.name.startswith(".") and (suffix in READABLE or suffix == "" or suffix[1:].isdigit())
+
+
+def _unique(inputs: list, rows: list, manifest=None) -> tuple[list, list]:
+    """(items, notes): each file once; a file a manifest row names takes that row's metadata (the
+    plain input is dropped), the manifest itself is no record; a row listed twice is analysed once.
+    Notes: (file, message) per drop."""
+    named = {os.path.realpath(r["file"]) for r in rows}
+    if manifest is not None:
+        named.add(os.path.realpath(manifest))
+    items, notes, seen = [], [], set()
+    for it in [i for i in inputs if os.path.realpath(i["file"]) not in named] + rows:
+        key = (os.path.realpath(it["file"]), tuple(sorted((k, str(v)) for k, v in it.items() if k != "file")))
+        if key in seen:
+            notes.append((it["file"], "listed twice: analysed once"))
+            continue
+        seen.add(key)
+        items.append(it)
+    return items, notes
 
 
 # --- the work of one input (runs on a worker) ------------------------------------------------------
@@ -179,12 +216,14 @@ def _run(task, rec, item, options):
         return result, summary, {"nperseg": psd.params["nperseg"], "channel": psd.channels[0]}
     if task == "diagnose":
         rpm, tach = item.get("rpm"), item.get("tach")
+        # a row's channel is its point's sensor: the only one searched (another sensor's bearing is another point)
+        channels = [ch] if ch else None
         rpm = rec.meta.get("rpm") if rpm is None and tach is None else rpm   # the speed the file states
         if rpm is None and tach is None:
             raise ParameterError("task 'diagnose' needs the shaft speed: give rpm (or a tach channel) in the manifest, "
                                  "or a file that states it")
         d = vm.diagnose(rec, rpm=None if rpm is None else float(rpm), bearing=item.get("bearing"), channel=ch,
-                        tach=tach, pulses_per_rev=item.get("pulses_per_rev") or 1)
+                        channels=channels, tach=tach, pulses_per_rev=item.get("pulses_per_rev") or 1)
         rpm = d.speed.get("estimated_rpm") if rpm is None else rpm
         sev = d.severity or {}
         summary = {"top": d.top, "confidence": float(d.confidence),
@@ -216,9 +255,8 @@ def analyse_file(item: dict, tasks, options: dict | None = None) -> dict:
     with one_blas_thread(), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            import vibmeasure as vm
             out["sha256"] = file_sha256(item["file"])
-            rec = vm.read(item["file"], fs=options.get("fs"))
+            rec = _read(item, options)
             out["channels"] = [c.name for c in rec.channels]
             out["n_samples"], out["fs"] = int(rec.n_samples), float(rec.fs)
             t = item.get("time") or rec.meta.get("time") or rec.meta.get("start_time")
@@ -227,8 +265,8 @@ def analyse_file(item: dict, tasks, options: dict | None = None) -> dict:
             out["errors"]["read"] = f"{type(exc).__name__}: {exc}"
             return out
         for task in tasks:
-            if task == "compare":
-                continue
+            if task == "compare" or ("_only" in item and task not in item["_only"]):
+                continue   # compare is the client's; a re-run does only the tasks still missing
             if task == "auto":   # the file's content decides, as in the report
                 task = analysis_for(rec, rpm=item.get("rpm"), tach=item.get("tach"))
             try:
@@ -240,9 +278,20 @@ def analyse_file(item: dict, tasks, options: dict | None = None) -> dict:
     return out
 
 
+def _read(item: dict, options: dict):
+    """The input as a Record, with the row's fs and unit where the file does not state them."""
+    import vibmeasure as vm
+    fs = item.get("fs") or options.get("fs")
+    return vm.read(item["file"], fs=fs, **({"unit": item["unit"]} if item.get("unit") else {}))
+
+
 # --- the client -----------------------------------------------------------------------------------
+def _asset_of(item) -> str:
+    return item.get("asset") or Path(item["file"]).parent.name or "default"
+
+
 def _register(store, item, channels):
-    asset = item.get("asset") or Path(item["file"]).parent.name or "default"
+    asset = _asset_of(item)
     point = item.get("point") or item.get("channel") or (channels[0] if channels else "point")
     if asset not in store._assets:
         store.add_asset(asset, bearing=item.get("bearing"), model=item.get("model"))
@@ -297,12 +346,13 @@ def _store_one(store, out, tasks, keep_raw, options):
     item = out["item"]
     asset, point = _register(store, item, out.get("channels", []))
     rec = None
-    if keep_raw and not out["errors"].get("read"):
-        import vibmeasure as vm
-        rec = vm.read(item["file"], fs=options.get("fs"))
-    mid = store.add_measurement(asset, point, time=out["time"] if out["time"] is not None else _time.time(),
-                                rpm=item.get("rpm"), sha256=out["sha256"], file=str(item["file"]), record=rec,
-                                keep_raw=keep_raw)
+    if keep_raw and not out["errors"].get("read") and item.get("_mid") is None:
+        rec = _read(item, options)
+    mid = item.get("_mid")   # a measurement already stored is analysed again: its results are added to it
+    if mid is None:
+        mid = store.add_measurement(asset, point, time=out["time"] if out["time"] is not None else _time.time(),
+                                    rpm=item.get("rpm"), sha256=out["sha256"], file=str(item["file"]), record=rec,
+                                    keep_raw=keep_raw)
     for task, (result, summary, params) in out["results"].items():
         store.add_result(mid, task, result, params=params, summary=summary)
     if "compare" in tasks and not out["errors"].get("read"):
@@ -378,34 +428,31 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
     """
     from ..io.store import Store, is_store
     tasks = _tasks(task)
-    items = _expand(inputs) if inputs else []
-    if manifest is not None:
-        items += read_manifest(manifest)
+    items, notes = _unique(_expand(inputs) if inputs else [], read_manifest(manifest) if manifest is not None else [],
+                           manifest)
     if not items:
         raise ParameterError("no input: give files, folders or globs, or a manifest")
     options = {"fs": fs, "band": band}
     own = not is_store(store)
     st = Store(store, writable=True) if own else store
-    rows, todo = [], []
+    rows, todo = [(f, "skipped", None, m) for f, m in notes], []
     try:
-        errs = st.errors()
-        failures = dict(zip(errs["measurement"], errs["message"])) if "message" in errs else {}
-        known = st.n_measurements > 0  # an empty store has nothing to skip: no need to hash every input twice
+        stored = _Stored(st, tasks) if st.n_measurements else None
         for it in items:
-            sha = None
-            if not force and known:
-                try:
-                    sha = file_sha256(it["file"])
-                except OSError as exc:
-                    rows.append((it["file"], "error", None, str(exc)))
-                    continue
-            mid = st.has(sha) if sha else None
-            if mid is not None:
-                failed = failures.get(mid)
-                rows.append((it["file"], "skipped", mid, "already in the store (same content)" +
-                             (f"; it failed then: {failed}" if failed else "") + "; force=True to analyse again"))
-            else:
+            if stored is None:
                 todo.append(it)
+                continue
+            try:
+                sha = file_sha256(it["file"])
+            except OSError as exc:
+                rows.append((it["file"], "error", None, str(exc)))
+                continue
+            mid, missing = stored.find(sha, it)
+            if mid is not None and not missing and not force:
+                rows.append((it["file"], "skipped", mid, "already in the store (same content, every task done); "
+                             "force=True to analyse again"))
+            else:
+                todo.append(it if mid is None else dict(it, _mid=mid) if force else dict(it, _mid=mid, _only=missing))
         total = len(todo)
         done = committed = 0
         last_commit = _time.monotonic()
@@ -455,6 +502,40 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
             st.close()
     import pandas as pd
     return pd.DataFrame(rows, columns=["file", "status", "measurement", "message"])
+
+
+class _Stored:
+    """What a store holds for a batch's skip rule: per content hash and asset, the measurements (point,
+    id), and per measurement the tasks with a result (an error is no result)."""
+
+    def __init__(self, st, tasks):
+        m = st.measurements()
+        self.by_content: dict = {}
+        for mid, sha, asset, point in zip(m["id"], m["sha256"], m["asset"], m["point"]):
+            if sha:
+                self.by_content.setdefault((sha, asset), []).append((point, mid))
+        wanted = [t for t in tasks if t not in ("compare", "auto")] or list(TASKS)
+        self.tasks = [t for t in tasks if t != "auto"]
+        self.any_task = "auto" in tasks
+        self.done: dict = {}
+        for t in set(wanted) | (set(TASKS) if self.any_task else set()):
+            df = st.results(t)
+            for mid in (df["measurement"] if not df.empty else ()):
+                self.done.setdefault(mid, set()).add(t)
+
+    def find(self, sha: str, item: dict) -> tuple:
+        """(measurement id or None, tasks still missing) for an input: the latest measurement of that
+        content at its asset and (when the item names one) point."""
+        point = item.get("point") or item.get("channel")
+        hits = [mid for p, mid in self.by_content.get((sha, _asset_of(item)), ()) if point is None or p == point]
+        if not hits:
+            return None, list(self.tasks)
+        mid = hits[-1]
+        have = self.done.get(mid, set())
+        missing = [t for t in self.tasks if t not in have]
+        if self.any_task and not have:
+            missing.append("auto")
+        return mid, missing
 
 
 def _client(client, workers, scheduler):

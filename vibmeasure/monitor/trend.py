@@ -7,7 +7,15 @@ Limits: watch at baseline mean + K_WATCH std, alarm at + K_ALARM std, in the met
 never closer to the baseline than the metric's floor (a relative change, or an absolute level), so a
 very quiet baseline does not turn measurement noise into alarms. A level counts only when the last
 two measurements both reach it (one outlier is a watch at most). A significant slope (above 2 std)
-that reaches the alarm limit within ``horizon_days`` raises ok to watch.
+that reaches the alarm limit within ``horizon_days``, and no further ahead than the history since the
+baseline reaches back (a warm-up over hours says nothing about weeks), raises ok to watch.
+
+Absolute rules need no baseline: a fault the diagnosis names with confidence >= 0.5 in the last two
+measurements is an alarm (in the last one, a watch), and the ISO 10816-3 zone C or D of the velocity
+is a watch or an alarm; a baseline taken while a fault was already there cannot hide it. A point
+with fewer measurements than the baseline needs is listed ("no baseline yet") with what the absolute rules
+say, never left out. A measurement analysed again (``batch(force=True)``) counts once, by its
+latest result.
 """
 
 from __future__ import annotations
@@ -20,6 +28,8 @@ __all__ = ["trend", "metric_history", "METRICS"]
 
 K_WATCH, K_ALARM = 3.0, 6.0
 LEVELS = ("ok", "watch", "alarm")
+TOO_FEW = -1            # a point whose history is shorter than the baseline: no relative limit yet
+NAMED = 0.5             # a diagnosis naming a fault from this confidence on counts as a finding
 # task, summary column, bad direction (+1 rising, -1 falling, 0 either), floor kind, watch floor, alarm floor
 METRICS = (
     ("diagnose", "velocity_rms_mm_s", +1, "relative", 0.5, 1.0),
@@ -93,63 +103,19 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
     if isinstance(baseline_count, bool) or not isinstance(baseline_count, (int, np.integer)) or baseline_count < 2:
         raise ParameterError(f"baseline_count={baseline_count!r} must be an integer >= 2")
     rows = []
+    # one row per measurement: a measurement analysed again counts once, by its latest result
+    frames = {task: st.results(task, asset=asset, point=point) for task in dict.fromkeys(t for t, *_ in METRICS)}
+    rows += _diagnosis_rows(frames.get("diagnose"))
     for task, col, direction, kind, fw, fa in METRICS:
-        df = st.results(task, asset=asset, point=point)
+        df = frames[task]
         if df.empty or col not in df:
             continue
         for (a, p), g in df.groupby(["asset", "point"], sort=True):
             g = g[np.isfinite(pd.to_numeric(g[col], errors="coerce"))]
             if len(g) < baseline_count + 1:
+                rows.append(_too_few(a, p, task, col, g, baseline_count))
                 continue
-            y = g[col].to_numpy(float)
-            t = (g["time"] - g["time"].iloc[0]).dt.total_seconds().to_numpy() / 86400.0
-            base = y[:baseline_count]
-            mu, sd, dw, da = _limits(base, direction, kind, fw, fa)
-            lv = [_level(v, mu, dw, da, direction) for v in y[baseline_count:]]
-            level = min(lv[-2:]) if len(lv) >= 2 else min(lv[-1], 1)
-            # when each level was first reached (two measurements in a row): the alarm history
-            held = [min(lv[j - 1], lv[j]) for j in range(1, len(lv))]
-            first = {}
-            for lvl in (1, 2):
-                j = next((j for j, h in enumerate(held) if h >= lvl), None)
-                first[lvl] = None if j is None else g["time"].iloc[baseline_count + j + 1]
-            reason = f"{col} {y[-1]:.4g} against baseline {mu:.4g} +- {sd:.2g}"
-            if level:
-                reason += f" (beyond the {LEVELS[level]} limit in the last two measurements)"
-            elif lv[-1]:
-                reason += f" (one measurement beyond the {LEVELS[lv[-1]]} limit)"
-                level = 1
-            # trend over the measurements since the baseline
-            tt, yy = t[baseline_count:], y[baseline_count:]
-            slope = slope_std = np.nan
-            cross = None
-            if tt.size >= 3 and np.ptp(tt) > 0:
-                A = np.column_stack([np.ones_like(tt), tt - tt.mean()])
-                coef, res, *_ = np.linalg.lstsq(A, yy, rcond=None)
-                r = yy - A @ coef
-                s2 = float(r @ r) / max(tt.size - 2, 1)
-                slope = float(coef[1])
-                slope_std = float(np.sqrt(s2 / np.sum((tt - tt.mean()) ** 2)))
-                sign = direction if direction else (np.sign(yy[-1] - mu) or 1)
-                lim = mu + sign * da
-                if slope * sign > 2 * slope_std and slope != 0:
-                    t_cross = tt.mean() + (lim - coef[0]) / slope
-                    if t_cross > tt[-1]:
-                        cross = g["time"].iloc[0] + pd.Timedelta(days=float(t_cross))
-                        if level == 0 and t_cross - tt[-1] <= horizon_days:
-                            level = 1
-                            reason += f"; trending to the alarm limit by {cross:%Y-%m-%d}"
-            if col == "velocity_rms_mm_s" and "zone" in g:
-                z = ISO_VERDICT.get(str(g["zone"].iloc[-1]), 0)
-                if z and (len(g) < 2 or ISO_VERDICT.get(str(g["zone"].iloc[-2]), 0) >= z) and z > level:
-                    level, reason = z, reason + f"; ISO 10816-3 zone {g['zone'].iloc[-1]}"
-            sign = direction if direction else (1 if y[-1] >= mu else -1)  # either way: the side it went
-            rows.append({"asset": a, "point": p, "task": task, "metric": col, "n": len(y),
-                         "baseline_mean": mu, "baseline_std": sd, "watch_limit": mu + sign * dw,
-                         "alarm_limit": mu + sign * da, "last": float(y[-1]), "last_time": g["time"].iloc[-1],
-                         "slope_per_day": slope, "slope_std": slope_std, "alarm_date": cross,
-                         "first_watch": first[1], "first_alarm": first[2],
-                         "level": level, "verdict": LEVELS[level], "reason": reason})
+            rows.append(_relative(a, p, task, col, g, (direction, kind, fw, fa), baseline_count, horizon_days))
     out = pd.DataFrame(rows, columns=["asset", "point", "task", "metric", "n", "baseline_mean", "baseline_std",
                                       "watch_limit", "alarm_limit", "last", "last_time", "slope_per_day",
                                       "slope_std", "alarm_date", "first_watch", "first_alarm", "level",
@@ -158,9 +124,61 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
     out = out.reset_index(drop=True)
     pts = out.groupby(["asset", "point"])["level"].max() if not out.empty else {}
     ass = out.groupby("asset")["level"].max() if not out.empty else {}
-    out.attrs["points"] = {f"{a}/{p}": LEVELS[int(v)] for (a, p), v in dict(pts).items()}
-    out.attrs["assets"] = {a: LEVELS[int(v)] for a, v in dict(ass).items()}
+    out.attrs["points"] = {f"{a}/{p}": _verdict(v) for (a, p), v in dict(pts).items()}
+    out.attrs["assets"] = {a: _verdict(v) for a, v in dict(ass).items()}
     return out.drop(columns="level")
+
+
+def _verdict(level) -> str:
+    return "no baseline yet" if int(level) == TOO_FEW else LEVELS[int(level)]
+
+
+def _row(a, p, task, metric, n, last, last_time, level, reason, **values) -> dict:
+    """A trend row without a baseline's statistics (absolute rules, too short a history)."""
+    nan = float("nan")
+    row = {"asset": a, "point": p, "task": task, "metric": metric, "n": n, "baseline_mean": nan,
+           "baseline_std": nan, "watch_limit": nan, "alarm_limit": nan, "last": last, "last_time": last_time,
+           "slope_per_day": nan, "slope_std": nan, "alarm_date": None, "first_watch": None, "first_alarm": None,
+           "level": level, "verdict": _verdict(level), "reason": reason}
+    row.update(values)
+    return row
+
+
+def _too_few(a, p, task, col, g, baseline_count) -> dict:
+    """A point whose history is shorter than the baseline needs: listed, with the ISO zone of the
+    velocity where it is C or D in the last two measurements."""
+    n = len(g)
+    last = float(g[col].iloc[-1]) if n else float("nan")
+    level, reason = TOO_FEW, (f"{n} measurement(s) of {col}: no baseline yet (it needs {baseline_count} to "
+                              "estimate the spread, and one more to judge against it)")
+    if col == "velocity_rms_mm_s" and "zone" in g and n:
+        zones = [ISO_VERDICT.get(str(z), 0) for z in g["zone"].iloc[-2:]]
+        z = min(zones)
+        if z:
+            level = z
+            reason += f"; ISO 10816-3 zone {g['zone'].iloc[-1]} in the last {len(zones)} measurement(s)"
+    return _row(a, p, task, col, n, last, g["time"].iloc[-1] if n else None, level, reason)
+
+
+def _diagnosis_rows(df) -> list:
+    """Per point, the absolute rule on the diagnosis itself: a fault named with confidence >= NAMED
+    in the last two measurements is an alarm, in the last one a watch, whatever the baseline (an
+    asset whose first measurements already carry the fault has a baseline that hides it)."""
+    if df is None or df.empty or "top" not in df or "confidence" not in df:
+        return []
+    rows = []
+    for (a, p), g in df.groupby(["asset", "point"], sort=True):
+        conf = g["confidence"].astype(float).to_numpy()
+        named = [(t not in ("none", "undetermined") and c >= NAMED) for t, c in zip(g["top"], conf)]
+        last2 = named[-2:]
+        level = 2 if len(last2) == 2 and all(last2) and g["top"].iloc[-1] == g["top"].iloc[-2] else \
+            1 if named[-1] else 0 if len(g) > 1 else TOO_FEW
+        top = g["top"].iloc[-1]
+        reason = (f"{top} named at {conf[-1]:.2f}" + (" in the last two measurements" if level == 2 else "")
+                  if named[-1] else f"last diagnosis {top} ({conf[-1]:.2f}): no fault named")
+        rows.append(_row(a, p, "diagnose", "diagnosis", len(g), float(conf[-1]), g["time"].iloc[-1], level,
+                         reason))
+    return rows
 
 
 def metric_history(store, *, asset: str, point: str, metric: str, task: str | None = None,
@@ -209,3 +227,61 @@ def metric_history(store, *, asset: str, point: str, metric: str, task: str | No
     tr = trend(st, asset=asset, point=point, baseline_count=baseline_count)
     row = tr[tr["metric"] == metric]
     return df, (None if row.empty else row.iloc[0])
+
+
+def _relative(a, p, task, col, g, rule, baseline_count, horizon_days) -> dict:
+    """The trend row of one point's metric with a baseline: limits from the baseline's spread (``rule``:
+    direction, floor kind, watch and alarm floors), the level held over the last two measurements, the
+    slope since the baseline and where it leads, the ISO zone for velocity."""
+    import pandas as pd
+    direction, kind, fw, fa = rule
+    y = g[col].to_numpy(float)
+    t = (g["time"] - g["time"].iloc[0]).dt.total_seconds().to_numpy() / 86400.0
+    base = y[:baseline_count]
+    mu, sd, dw, da = _limits(base, direction, kind, fw, fa)
+    lv = [_level(v, mu, dw, da, direction) for v in y[baseline_count:]]
+    level = min(lv[-2:]) if len(lv) >= 2 else min(lv[-1], 1)
+    # when each level was first reached (two measurements in a row): the alarm history
+    held = [min(lv[j - 1], lv[j]) for j in range(1, len(lv))]
+    first = {}
+    for lvl in (1, 2):
+        j = next((j for j, h in enumerate(held) if h >= lvl), None)
+        first[lvl] = None if j is None else g["time"].iloc[baseline_count + j + 1]
+    reason = f"{col} {y[-1]:.4g} against baseline {mu:.4g} +- {sd:.2g}"
+    if level:
+        reason += f" (beyond the {LEVELS[level]} limit in the last two measurements)"
+    elif lv[-1]:
+        reason += f" (one measurement beyond the {LEVELS[lv[-1]]} limit)"
+        level = 1
+    # trend over the measurements since the baseline
+    tt, yy = t[baseline_count:], y[baseline_count:]
+    slope = slope_std = np.nan
+    cross = None
+    if tt.size >= 3 and np.ptp(tt) > 0:
+        A = np.column_stack([np.ones_like(tt), tt - tt.mean()])
+        coef, res, *_ = np.linalg.lstsq(A, yy, rcond=None)
+        r = yy - A @ coef
+        s2 = float(r @ r) / max(tt.size - 2, 1)
+        slope = float(coef[1])
+        slope_std = float(np.sqrt(s2 / np.sum((tt - tt.mean()) ** 2)))
+        sign = direction if direction else (np.sign(yy[-1] - mu) or 1)
+        lim = mu + sign * da
+        if slope * sign > 2 * slope_std and slope != 0:
+            t_cross = tt.mean() + (lim - coef[0]) / slope
+            # no further ahead than the history since the baseline reaches back
+            if tt[-1] < t_cross <= tt[-1] + np.ptp(tt):
+                cross = g["time"].iloc[0] + pd.Timedelta(days=float(t_cross))
+                if level == 0 and t_cross - tt[-1] <= horizon_days:
+                    level = 1
+                    reason += f"; trending to the alarm limit by {cross:%Y-%m-%d}"
+    if col == "velocity_rms_mm_s" and "zone" in g:
+        z = ISO_VERDICT.get(str(g["zone"].iloc[-1]), 0)
+        if z and (len(g) < 2 or ISO_VERDICT.get(str(g["zone"].iloc[-2]), 0) >= z) and z > level:
+            level, reason = z, reason + f"; ISO 10816-3 zone {g['zone'].iloc[-1]}"
+    sign = direction if direction else (1 if y[-1] >= mu else -1)  # either way: the side it went
+    return {"asset": a, "point": p, "task": task, "metric": col, "n": len(y),
+                 "baseline_mean": mu, "baseline_std": sd, "watch_limit": mu + sign * dw,
+                 "alarm_limit": mu + sign * da, "last": float(y[-1]), "last_time": g["time"].iloc[-1],
+                 "slope_per_day": slope, "slope_std": slope_std, "alarm_date": cross,
+                 "first_watch": first[1], "first_alarm": first[2],
+                 "level": level, "verdict": LEVELS[level], "reason": reason}

@@ -186,7 +186,8 @@ def fleet_section(store, name):
                                                                                        "verdict", "reason"],
                           "rows": [[r.asset, r.point, r.metric, _fmt(r.baseline_mean, 4), _fmt(r.last, 4),
                                     _fmt(r.alarm_limit, 4), r.verdict, r.reason] for r in tr.itertuples()]})
-    for r in tr[tr["verdict"] != "ok"].head(4).itertuples():
+    # the trended metrics (a baseline to draw against) that are not ok
+    for r in tr[(tr["verdict"] != "ok") & tr["baseline_mean"].notna()].head(4).itertuples():
         ax = plot.plot_trend(store, asset=r.asset, point=r.point, metric=r.metric, task=r.task)
         sec["figures"].append({"svg": _svg(ax.figure), "caption": f"{r.asset}/{r.point}: {r.metric}"})
     return sec

@@ -106,7 +106,8 @@ class _SQLQueries:
 
     def results(self, task: str, asset: str | None = None, point: str | None = None, since=None, until=None):
         """Results of one task as a DataFrame, oldest first (``Store.results``): measurement, asset, point,
-        time, task, version, params, the summary values as columns and ``result``.
+        time, task, version, params, the summary values as columns and ``result``; one row per
+        measurement, its latest result of the task.
 
         Examples
         --------
@@ -127,6 +128,10 @@ class _SQLQueries:
         stmt = (sa.select(r.c.measurement, m.c.asset, m.c.point, m.c.time, r.c.task, r.c.version, r.c.params,
                           r.c.summary, r.c.result, m.c.id).join(m, r.c.measurement == m.c.id)
                 .where(r.c.task == task))
+        if task == "error":   # an error a later analysis of the same measurement succeeded past is gone
+            r2 = r.alias("later")
+            stmt = stmt.where(~sa.exists().where(r2.c.measurement == r.c.measurement, r2.c.task != "error",
+                                                 r2.c.id > r.c.id))
         stmt = self._where(stmt, m, asset, point, since, until).order_by(r.c.id)
         base = ["measurement", "asset", "point", "time", "task", "version", "params"]
         flat = [{"measurement": _mid(x["measurement"]), "asset": x["asset"], "point": x["point"], "time": x["time"],
@@ -134,7 +139,8 @@ class _SQLQueries:
                  **(_loads(x["summary"]) or {}), "result": _loads(x["result"])} for x in self._rows(stmt)]
         if not flat:
             return pd.DataFrame(columns=base)
-        df = pd.DataFrame(flat)
+        # a measurement analysed again: its latest result of the task replaces the earlier ones
+        df = pd.DataFrame(flat).drop_duplicates("measurement", keep="last").reset_index(drop=True)
         df["time"] = pd.to_datetime(df["time"], unit="s", utc=True)
         return df
 
