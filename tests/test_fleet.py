@@ -295,6 +295,11 @@ def test_files_and_a_manifest_and_sensors_by_channel(tmp_path):
     (stamped / "rows.csv").write_text("file,asset,fs,unit\n2004.02.12.10.32.39,rig,12800,g\n")
     found = vm.batch([stamped], task="spectrum", store=tmp_path / "s2.db", manifest=stamped / "rows.csv")
     assert found["status"].tolist() == ["done"], found["message"].tolist()
+    # a folder's own manifest is no record, even when the batch is not told it is the manifest
+    (stamped / "other.csv").write_text("file,asset\n2004.02.12.10.32.39,rig\n")
+    rep = vm.batch([stamped], task="spectrum", store=tmp_path / "s3.db", fs=12800.0)
+    assert sorted(rep["status"]) == ["done", "skipped", "skipped"], rep.to_string()
+    assert rep.loc[rep["status"] == "skipped", "message"].str.contains("a manifest, not a record").all()
     r = vm.Store(tmp_path / "s2.db").results("spectrum")
     assert r["result"].iloc[0]["unit"].startswith("g")
 

@@ -157,14 +157,32 @@ def _data_name(p: Path) -> bool:
     return not p.name.startswith(".") and (suffix in READABLE or suffix == "" or suffix[1:].isdigit())
 
 
+def _is_manifest(path) -> bool:
+    """Whether a CSV file is a manifest (its header: a ``file`` column and manifest columns only), not
+    a record: a folder of records often holds its manifest too."""
+    if Path(path).suffix.lower() != ".csv":
+        return False
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            head = next(csv.reader(fh), [])
+    except (OSError, UnicodeDecodeError, csv.Error):
+        return False
+    cols = [c.strip() for c in head]
+    return "file" in cols and all(c in MANIFEST_COLUMNS for c in cols)
+
+
 def _unique(inputs: list, rows: list, manifest=None) -> tuple[list, list]:
     """(items, notes): each file once; a file a manifest row names takes that row's metadata (the
-    plain input is dropped), the manifest itself is no record; a row listed twice is analysed once.
-    Notes: (file, message) per drop."""
+    plain input is dropped), a manifest is no record; a row listed twice is analysed once. Notes:
+    (file, message) per drop."""
     named = {os.path.realpath(r["file"]) for r in rows}
     if manifest is not None:
         named.add(os.path.realpath(manifest))
     items, notes, seen = [], [], set()
+    for it in inputs:
+        if os.path.realpath(it["file"]) not in named and _is_manifest(it["file"]):
+            notes.append((it["file"], "a manifest, not a record: give it as manifest= (--manifest)"))
+            named.add(os.path.realpath(it["file"]))
     for it in [i for i in inputs if os.path.realpath(i["file"]) not in named] + rows:
         key = (os.path.realpath(it["file"]), tuple(sorted((k, str(v)) for k, v in it.items() if k != "file")))
         if key in seen:
