@@ -64,7 +64,7 @@ def test_csv_non_uniform_time_column(tmp_path):
 
 def test_csv_truncated_and_garbage(tmp_path):
     p = tmp_path / "trunc.csv"
-    p.write_text("time,a,b\n0,1,2\n0.1,3,4\n0.2,5")   # cut inside the last line: dropped, said so
+    p.write_text("time,a,b\n0,1,2\n0.1,3,4\n0.2,5")   # a last line with a field missing: dropped, said so
     with pytest.warns(vm.QualityWarning, match="no end of line"):
         assert vm.read(p).n_samples == 2
     p.write_text("time,a,b\n0,1,2\n0.1,3,4\n0.2,5\n")   # a short last row with its end of line: refused
@@ -466,3 +466,20 @@ def test_whitespace_separated_columns_are_read(tmp_path):
     vm.write(tmp_path / "r.h5", rec)
     with pytest.raises(vm.ParameterError, match="applies to text files"):
         vm.read(tmp_path / "r.h5", delimiter=",")
+
+
+def test_a_24_bit_pcm_wav_reads_at_full_scale(tmp_path):
+    """Measurement recorders write 24-bit PCM, which cannot be memory-mapped: it is read (its size bounded
+    by the file's first) and scaled to full scale 1.0, sample for sample (oracle: the integers written)."""
+    import struct
+    n, fs = 1000, 48000
+    ints = (np.sin(2 * np.pi * 1000 * np.arange(n) / fs) * (2 ** 23 - 1)).astype(np.int32)
+    ints[0], ints[1] = -(2 ** 23), 2 ** 23 - 1
+    frames = b"".join(int(v).to_bytes(4, "little", signed=True)[:3] for v in ints)
+    fmt = struct.pack("<HHIIHH", 1, 1, fs, fs * 3, 3, 24)
+    body = b"WAVE" + b"fmt " + struct.pack("<I", len(fmt)) + fmt + b"data" + struct.pack("<I", len(frames)) + frames
+    p = tmp_path / "rec24.wav"
+    p.write_bytes(b"RIFF" + struct.pack("<I", len(body)) + body)
+    r = vm.read(p)
+    assert r.fs == fs and r.n_samples == n
+    np.testing.assert_array_equal(r.data[0], ints / 2.0 ** 23)   # exact: 24-bit integers over 2^23

@@ -6,6 +6,7 @@ import subprocess
 import sys
 import textwrap
 import time
+import warnings
 
 import h5py
 import numpy as np
@@ -64,10 +65,18 @@ def test_lvm_cut_at_any_line_end_or_inside_a_number_is_refused(tmp_path):
         assert _outcome(p, original) == "named", k
 
 
-def test_csv_cut_inside_the_last_number_is_dropped_with_a_warning(tmp_path):
+def test_a_complete_last_row_without_newline_is_data_and_a_cut_one_is_named(tmp_path):
+    """Hand edits and some exporters end a file without an end of line: a complete, well-formed last row
+    is data. A row that cannot be complete is dropped and named: fewer fields, or a number shorter than
+    its column's fixed width (every row before with the same number of decimals)."""
     p = tmp_path / "third_party.csv"    # no vibmeasure header: nothing states the length
     p.write_text("time,a\n0,1.5\n0.001,2.5\n0.002,3.25")
-    with pytest.warns(vm.QualityWarning, match="'0.002,3.25' has no end of line"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", vm.QualityWarning)
+        r = vm.read(p)
+    assert r.n_samples == 3 and r.data[0, -1] == 3.25
+    p.write_text("time,a\n0.000,1.500\n0.001,2.500\n0.002,3.2")   # fixed 3 decimals: '3.2' is cut
+    with pytest.warns(vm.QualityWarning, match="'0.002,3.2' has no end of line and its field 2"):
         r = vm.read(p)
     assert r.n_samples == 2 and r.data[0, -1] == 2.5
 

@@ -57,18 +57,54 @@ def _fields(line: str, sep: str) -> list:
 
 
 def _cut_last_line(text: str, src: str) -> str:
-    """A file whose last line has no end of line may have been cut inside that line (its last number
-    shortened): the line is dropped with a QualityWarning naming it."""
+    """A last line without an end of line (hand edits, some exporters) is data when it is complete: as
+    many fields as the row before it, and no number shorter than its column's fixed width (every earlier
+    row giving that column the same number of decimals). A line that cannot be complete (fewer fields, a
+    number cut short) is dropped with a QualityWarning naming it."""
     if not text or text.endswith(("\n", "\r")):
         return text
     head, _, last = text.rpartition("\n")
-    if last.strip() and not last.lstrip().startswith("#"):
-        import warnings
-        from ..core.errors import QualityWarning
-        warnings.warn(f"{src}: the last line {last[:60]!r} has no end of line (a cut file?); it was left out",
-                      QualityWarning, stacklevel=4)
-        return head + "\n"
-    return text
+    if not last.strip() or last.lstrip().startswith("#"):
+        return text
+    rows = [ln for ln in head.splitlines()[-50:] if ln.strip() and not ln.lstrip().startswith("#")]
+    why = _incomplete(last, rows)
+    if why is None:
+        return text + "\n"
+    import warnings
+    from ..core.errors import QualityWarning
+    warnings.warn(f"{src}: the last line {last[:60]!r} has no end of line and {why} (a cut file?); it was left out",
+                  QualityWarning, stacklevel=4)
+    return head + "\n"
+
+
+_FIELD = re.compile(r"[^,;\t ]+")
+
+
+def _number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _incomplete(last: str, rows: list) -> str | None:
+    """Why ``last`` cannot be a complete row after ``rows`` (the lines before it), or None."""
+    if not rows:
+        return None
+    fields = _FIELD.findall(last)
+    before = [_FIELD.findall(r) for r in rows]
+    if len(fields) != len(before[-1]):
+        return f"has {len(fields)} field(s) where the row before has {len(before[-1])}"
+    same = [b for b in before if len(b) == len(fields) and all(_number(x) for x in b)]
+    for k, f in enumerate(fields):
+        widths = {len(b[k].split(".")[1]) if b[k].count(".") == 1 else None for b in same}
+        if len(widths) == 1 and None not in widths and len(same) >= 2:
+            w = widths.pop()
+            got = len(f.split(".")[1]) if f.count(".") == 1 else 0
+            if got < w and "e" not in f.lower():
+                return f"its field {k + 1} ({f!r}) has {got} decimal(s) where every row before has {w}"
+    return None
 
 
 def _check_digest(text: str, src: str) -> None:

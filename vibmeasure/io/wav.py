@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import struct
 import warnings
 
@@ -21,7 +22,15 @@ def read_wav(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", wavfile.WavFileWarning)
-            rate, data = wavfile.read(path, mmap=True)  # mapped, not loaded: sizes are checked first
+            try:
+                rate, data = wavfile.read(path, mmap=True)  # mapped, not loaded: sizes are checked first
+            except ValueError as exc:
+                if "mmap" not in str(exc):
+                    raise
+                # 24-bit PCM (what measurement recorders write) cannot be mapped: its size is bounded by
+                # the file's (3 bytes a sample) before it is read into int32 samples, left-justified
+                check_size(os.path.getsize(path) // 3, source=src, max_samples=max_samples)
+                rate, data = wavfile.read(path, mmap=False)
     except (ValueError, EOFError, OSError, struct.error, wavfile.WavFileWarning) as exc:
         raise ParameterError(f"{src} is unreadable (truncated or not WAV): {exc}") from None
     check_size(data.size, source=src, max_samples=max_samples)
