@@ -3,8 +3,8 @@ makes (one asset's year of results).
 
 A plant of ASSETS machines measured hourly: each commit adds 50 measurements with one diagnosis result
 each. Printed per engine at 1k, 10k, 100k, ... results: the mean time of 10 commits there, the time of
-``results("diagnose", asset=..., since=..., until=...)`` over one asset's year and of ``vm.trend`` on
-that asset. The HDF5 store copies and seals its whole file on every commit, so it is run only up to
+``results("diagnose", asset=..., since=..., until=...)`` over one asset's year (median of 3) and of
+``vm.trend`` on that asset. The HDF5 store copies and seals its whole file on every commit, so it is run only up to
 20,000 results; a database appends rows in a transaction. PostgreSQL is run when a URL of an empty
 database is given (the tests start a throw-away cluster the same way). Targets: commit cost flat
 (last / first <= 3), the year's query under 0.2 s.
@@ -49,9 +49,12 @@ def run(target, n: int, raw_dir=None) -> list:
             if marks and k >= marks[0]:
                 ms = 1e3 * sum(times[-10:]) / len(times[-10:])
                 year = min(8760.0, k / ASSETS)
-                t1 = time.perf_counter()
-                df = st.results("diagnose", asset="pump-000", since=T0, until=T0 + HOUR * year)
-                q = time.perf_counter() - t1
+                qs = []
+                for _ in range(3):   # the median of 3: the first after a commit may wait on the disk
+                    t1 = time.perf_counter()
+                    df = st.results("diagnose", asset="pump-000", since=T0, until=T0 + HOUR * year)
+                    qs.append(time.perf_counter() - t1)
+                q = sorted(qs)[1]
                 t1 = time.perf_counter()
                 vm.trend(st, asset="pump-000")
                 tr = time.perf_counter() - t1

@@ -33,3 +33,14 @@ def _check_name(value, what: str) -> str:
     if not isinstance(value, str) or not value.strip() or len(value) > 200 or any(c in value for c in "\n\r\0"):
         raise ParameterError(f"{what}={value!r} must be a non-empty name (one line, at most 200 characters)")
     return value
+
+
+def _asset_row(asset, kind, bearing, gear, model, iso_group, foundation, meta) -> dict:
+    """An asset's row as every store keeps it, its name and ISO group checked."""
+    _check_name(asset, "asset")
+    if iso_group is not None and iso_group not in (1, 2):
+        raise ParameterError(f"iso_group={iso_group!r} must be 1 or 2 (ISO 10816-3)")
+    return {"asset": asset, "kind": str(kind), "bearing": None if bearing is None else str(bearing),
+            "gear": gear, "model": None if model is None else str(model), "iso_group": iso_group,
+            "foundation": foundation, "meta": meta or {}}
+

@@ -7,7 +7,7 @@ import json
 import numpy as np
 
 from ..core.errors import ParameterError
-from ._store_common import _check_name, _seconds
+from ._store_common import _asset_row, _check_name, _seconds
 
 
 class _Writes:
@@ -69,12 +69,7 @@ class _Writes:
         ['6205-2RS']
         """
         self._need_writable()
-        _check_name(asset, "asset")
-        if iso_group is not None and iso_group not in (1, 2):
-            raise ParameterError(f"iso_group={iso_group!r} must be 1 or 2 (ISO 10816-3)")
-        row = {"asset": asset, "kind": str(kind), "bearing": None if bearing is None else str(bearing),
-               "gear": gear, "model": None if model is None else str(model), "iso_group": iso_group,
-               "foundation": foundation, "meta": meta or {}}
+        row = _asset_row(asset, kind, bearing, gear, model, iso_group, foundation, meta)
         json.dumps(row)  # must be JSON
         old = self._assets.get(asset)
         if old is not None:

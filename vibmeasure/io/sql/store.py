@@ -20,7 +20,7 @@ import time as _time
 from pathlib import Path
 
 from ...core.errors import ParameterError
-from .._store_common import STORE_SCHEMA, STORE_VERSION, StoreLockedError, _check_name, _seconds
+from .._store_common import STORE_SCHEMA, STORE_VERSION, StoreLockedError, _asset_row, _check_name, _seconds
 from . import schema as _schema_mod
 from .queries import _SQLQueries
 from .schema import _dumps, _insert, _mid, _mnum, _short, _tables, _url
@@ -300,12 +300,7 @@ class SQLStore(_SQLQueries):
         'fan-3'
         """
         self._need_writable()
-        _check_name(asset, "asset")
-        if iso_group is not None and iso_group not in (1, 2):
-            raise ParameterError(f"iso_group={iso_group!r} must be 1 or 2 (ISO 10816-3)")
-        row = {"asset": asset, "kind": str(kind), "bearing": None if bearing is None else str(bearing),
-               "gear": gear, "model": None if model is None else str(model), "iso_group": iso_group,
-               "foundation": foundation, "meta": meta or {}}
+        row = _asset_row(asset, kind, bearing, gear, model, iso_group, foundation, meta)
         try:
             db_row = dict(row, gear=_dumps(gear), meta=_dumps(row["meta"]))
         except (TypeError, ValueError):
