@@ -129,7 +129,7 @@ class SQLStore(_SQLQueries):
             self._conn = self._engine.connect()
             names = set(sa.inspect(self._conn).get_table_names())
             if "vibmeasure" not in names:
-                if names - {"vibmeasure"} and not names >= set(t):
+                if names - set(t):   # tables that are not a store's (ours alone: one being created)
                     raise ParameterError(f"store {self.target!r} is a database of something else (tables "
                                          f"{sorted(names)[:5]}), not a vibmeasure store")
                 if not self.writable:
@@ -153,22 +153,27 @@ class SQLStore(_SQLQueries):
                                  f"{STORE_VERSION}")
 
     def _create(self, sa):
-        """The schema and its version row. Two writers creating one store at once: the second's CREATE
-        fails on the tables the first made; it then finds them and goes on."""
+        """The schema and its version row. Two writers creating one store at once: a CREATE may fail on a
+        table the other just made; the missing ones are created again until every table stands, then
+        the version row is written (waiting for the other's transaction, nothing when it wrote it)."""
         t = _tables()
-        try:
-            _schema_mod._MD.create_all(self._conn, checkfirst=True)
-            ins = _insert(self._conn, t["vibmeasure"])
-            self._conn.execute(ins.values([{"key": "schema", "value": STORE_SCHEMA},
-                                           {"key": "schema_version", "value": str(STORE_VERSION)},
-                                           {"key": "created", "value": repr(_time.time())}])
-                               .on_conflict_do_nothing())
-            self._conn.commit()
-        except (sa.exc.OperationalError, sa.exc.ProgrammingError, sa.exc.IntegrityError) as exc:
-            self._conn.rollback()
-            if "vibmeasure" not in sa.inspect(self._conn).get_table_names():
-                raise exc
-            self._conn.rollback()
+        deadline = _time.monotonic() + self.timeout + 10.0
+        while True:   # each try creates the tables still missing; another writer may be creating them too
+            try:
+                _schema_mod._MD.create_all(self._conn, checkfirst=True)
+                self._conn.commit()
+                break
+            except (sa.exc.OperationalError, sa.exc.ProgrammingError, sa.exc.IntegrityError):
+                self._conn.rollback()
+                if _time.monotonic() > deadline:
+                    raise
+                _time.sleep(0.05)
+        ins = _insert(self._conn, t["vibmeasure"])
+        self._conn.execute(ins.values([{"key": "schema", "value": STORE_SCHEMA},
+                                       {"key": "schema_version", "value": str(STORE_VERSION)},
+                                       {"key": "created", "value": repr(_time.time())}])
+                           .on_conflict_do_nothing())
+        self._conn.commit()
 
     def _raise_operational(self, exc):
         text = _short(exc)
