@@ -109,6 +109,8 @@ def test_a_database_that_is_not_a_store_is_named(tmp_path):
         vm.Store(other, writable=True)
     with pytest.raises(vm.ParameterError, match="does not exist"):
         vm.Store(tmp_path / "missing.db")
+    with pytest.raises(vm.ParameterError, match="timeout='soon' must be a number of seconds"):
+        vm.Store(tmp_path / "t.db", writable=True, timeout="soon")
     with pytest.raises(vm.ParameterError, match="raw_dir= is for a database store"):
         vm.Store(tmp_path / "s.h5", writable=True, raw_dir=tmp_path)
 

@@ -307,6 +307,14 @@ class _Queries:
                     return row["id"]
         return None
 
+    def _measurements_with(self, tasks) -> dict:
+        """task -> the ids of the measurements with a result of it (one pass over the rows, no frame)."""
+        out = {t: set() for t in tasks}
+        for r in self._each("results"):
+            if r["task"] in out:
+                out[r["task"]].add(r["measurement"])
+        return out
+
     def _known(self, measurement) -> bool:
         if measurement in self._pending_meas:
             return True

@@ -182,6 +182,16 @@ class _SQLQueries:
         self._end_read()
         return None if n is None else _mid(n)
 
+    def _measurements_with(self, tasks) -> dict:
+        """task -> the ids of the measurements with a result of it (ids only: no JSON is parsed)."""
+        import sqlalchemy as sa
+        r = _tables()["results"]
+        out = {t: set() for t in tasks}
+        for m, t in self._run(sa.select(r.c.measurement, r.c.task).where(r.c.task.in_(list(tasks))).distinct()):
+            out[t].add(_mid(m))
+        self._end_read()
+        return out
+
     def _known(self, measurement) -> bool:
         import sqlalchemy as sa
         n = _mnum(measurement)

@@ -78,6 +78,8 @@ class SQLStore(_SQLQueries):
         self.path = Path(self.url[len("sqlite:///"):]) if self.is_sqlite else Path(self.url.rsplit("/", 1)[-1] or "db")
         self.target = str(target)
         self.writable = bool(writable)
+        if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not timeout == timeout:
+            raise ParameterError(f"timeout={timeout!r} must be a number of seconds (>= 0)")
         self.timeout = max(float(timeout), 0.0)
         if raw_dir is None and self.is_sqlite:
             raw_dir = self.path.with_name(self.path.name + ".raw")
