@@ -164,8 +164,10 @@ def test_beam_roots_against_published(bc, roots):
     fn = b.modes(3).fn
     np.testing.assert_allclose(fn, np.array(roots) ** 2 / (2 * np.pi) * np.sqrt(210e9 * 1e-8 / (7850 * 1e-4)),
                                rtol=5e-5)
+    # the shape is scaled to 1 at its true largest point, which a grid of 101 points may straddle
     y = b.shape(2, np.linspace(0, 1, 101))
-    assert np.max(np.abs(y)) == pytest.approx(1.0)
+    assert 0.999 < np.max(np.abs(y)) <= 1 + 1e-9
+    assert np.max(np.abs(b.shape(2, np.linspace(0, 1, 20001)))) == pytest.approx(1.0, abs=1e-7)
 
 
 def test_rod_string_stiffness_pendulum_whirl():
@@ -221,7 +223,7 @@ def test_update_sdof_and_mdof():
 
 @pytest.mark.parametrize("call,match", [
     (lambda: M.SDOF(m=0.0, k=1.0), "m="), (lambda: M.SDOF(m=1.0, k=-1.0), "k="),
-    (lambda: M.SDOF(m=1.0, k=1.0, zeta=0.1, c=1.0), "one of c, zeta"),
+    (lambda: M.SDOF(m=1.0, k=1.0, zeta=0.1, c=1.0), "one of c and zeta"),
     (lambda: M.SDOF(m=1.0, k=1.0, zeta=1.5).fd, "zeta=1.5 >= 1"),
     (lambda: M.MDOF(np.eye(2), np.array([[1.0, 2.0], [0.0, 1.0]])), "symmetric"),
     (lambda: M.MDOF(np.eye(2), np.array([[1.0, 2.0], [2.0, 1.0]])), "positive definite"),

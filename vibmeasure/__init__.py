@@ -20,6 +20,10 @@ __version__ = "0.1.0"
 # public name -> (module, attribute): imported when first used (PEP 562)
 _LAZY = {
     "half_power": (".identify.halfpower", "half_power"),
+    "loop_damping": (".identify.loop", "loop_damping"),
+    "stepped_sine": (".identify.stepped", "stepped_sine"),
+    "antiresonances": (".identify.antiresonance", "antiresonances"),
+    "LoopDamping": (".core.results", "LoopDamping"),
     "hilbert_decay": (".identify.damping", "hilbert_decay"),
     "log_decrement": (".identify.damping", "log_decrement"),
     "zeta_from_delta": (".identify.damping", "zeta_from_delta"),
@@ -113,6 +117,7 @@ __all__ = [
     "detrend", "filter", "decimate", "resample", "integrate", "differentiate",
     "ringdown", "ringdown_crb", "estimate_frf", "impact_frf", "find_hits", "fit_modes", "circle_fit", "mac",
     "modal_crb", "synthesize_frf", "oma_ssi", "oma_fdd", "oma_cross_check", "log_decrement", "hilbert_decay", "half_power", "zeta_from_delta",
+    "loop_damping", "LoopDamping", "stepped_sine", "antiresonances",
     "compare", "Comparison", "History", "diagnose", "Diagnosis", "severity_zone", "Bearing", "Gear", "BEARINGS",
     "Store", "StoreLockedError", "batch", "read_manifest", "trend", "report", "models", "synth", "units", "__version__",
 ]

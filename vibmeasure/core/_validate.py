@@ -192,7 +192,22 @@ def check_band(band, fs: float, *, name: str = "band") -> tuple[float, float] | 
     return lo, hi
 
 
+def finite_number(value, name: str) -> float:
+    """``value`` as a finite float; a bool, text or NaN is refused by name."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"{name}={value!r} must be a number, not a truth value")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}={value!r} must be a number") from None
+    if not np.isfinite(v):
+        raise ParameterError(f"{name}={value!r} must be finite")
+    return v
+
+
 def positive(value, name: str, *, allow_zero: bool = False) -> float:
+    if isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"{name}={value!r} must be a number, not a truth value")
     try:
         v = float(value)
     except (TypeError, ValueError):

@@ -45,7 +45,12 @@ def zeta_from_delta(delta):
     >>> round(float(vm.zeta_from_delta(0.1257)), 4)
     0.02
     """
-    delta = np.asarray(delta, dtype=float)
+    try:
+        delta = np.asarray(delta, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"delta={delta!r} must be a number or numbers") from None
+    if not np.all(np.isfinite(delta)) or np.any(delta < 0):
+        raise ParameterError("delta must be finite and >= 0: a negative decrement is a growing oscillation")
     return delta / np.sqrt(4 * np.pi ** 2 + delta ** 2)
 
 
@@ -165,6 +170,9 @@ def log_decrement(rec, *, channel=None, n: int | None = None, band=None, start: 
         flags.append("few_cycles")
     Td, Td_std = _period(tp, fd0)
     delta, delta_std = _decrement(tp, ap, Td, Td_std, n)
+    if not delta > 0:
+        raise FitError(f"log_decrement: the peaks do not decay (decrement {delta:.3g}): a driven or growing "
+                       "response, or a record that starts before the decay")
     zeta = float(zeta_from_delta(delta))
     dz = 4 * np.pi ** 2 / (4 * np.pi ** 2 + delta ** 2) ** 1.5
     zeta_std = float(dz * delta_std)

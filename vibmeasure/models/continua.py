@@ -1,5 +1,5 @@
-"""Continua and equivalent systems: rods, shafts, strings, Euler-Bernoulli beams, equivalent
-stiffness, pendulums and the whirling shaft. Frequencies come as ModalEstimates (zeta as given)."""
+"""Continua: rods, shafts, strings and Euler-Bernoulli beams. Frequencies come as ModalEstimates (zeta as
+given); shear and rotary inertia (Timoshenko, Rayleigh) are in ``beams.py``."""
 
 from __future__ import annotations
 
@@ -9,11 +9,10 @@ from scipy.optimize import brentq
 from ..core._validate import positive
 from ..core.errors import ParameterError
 from ..core.results import ModalEstimate
+from ._beam_solver import SectionModes, _Section
+from .expansion import ModalExpansion
 
-__all__ = ["Rod", "Shaft", "String", "Beam", "beta_l", "stiffness", "pendulum_period", "pendulum_gravity",
-           "compound_pendulum_fn", "whirling_speed_rpm", "series", "parallel"]
-
-_G0 = 9.80665
+__all__ = ["Rod", "Shaft", "String", "Beam", "beta_l"]
 
 
 MAX_MODES = 200   # beyond this cosh(beta L) overflows double precision in the beam equations
@@ -36,8 +35,8 @@ def _n(n):
     return int(n)
 
 
-class Rod:
-    """Axial vibration of a uniform rod.
+class Rod(ModalExpansion):
+    """Axial vibration of a uniform rod; with its section A, its forced response by modal expansion.
 
     Parameters
     ----------
@@ -51,6 +50,8 @@ class Rod:
         Boundary conditions (free-free: the flexible modes).
     zeta : float
         Modal damping ratio.
+    A : float, optional
+        Section in m^2 (needed for modal masses and the FRF).
 
     Raises
     ------
@@ -65,12 +66,36 @@ class Rod:
     1293.0
     """
 
-    def __init__(self, *, E, rho, L, bc="fixed-free", zeta=0.0):
+    def __init__(self, *, E, rho, L, bc="fixed-free", zeta=0.0, A=None):
         self.c = np.sqrt(positive(E, "E") / positive(rho, "rho"))
-        self.L = positive(L, "L")
+        self.rho, self.L = float(rho), positive(L, "L")
+        self._section_area = None if A is None else positive(A, "A")
         if bc not in ("fixed-free", "fixed-fixed", "free-free"):
             raise ParameterError(f"bc={bc!r} must be fixed-free, fixed-fixed or free-free")
         self.bc, self.zeta = bc, zeta
+
+    def _modal_set(self, n):
+        if self._section_area is None:
+            raise ParameterError(f"{type(self).__name__} needs its section ({'J' if isinstance(self, Shaft) else 'A'}) "
+                                 "for modal masses and forced response")
+        mu, L = self.rho * self._section_area, self.L
+        k = np.arange(1, n + 1)
+        w = 2 * np.pi * self.modes(n).fn
+        if self.bc == "fixed-free":
+            shape = lambda r, x: np.sin((2 * k[r] - 1) * np.pi * x / (2 * L))   # noqa: E731
+        elif self.bc == "fixed-fixed":
+            shape = lambda r, x: np.sin(k[r] * np.pi * x / L)   # noqa: E731
+        else:
+            shape = lambda r, x: np.cos(k[r] * np.pi * x / L)   # noqa: E731
+
+        def fields(r, x):
+            return shape(r, np.asarray(x, float)), np.zeros(np.shape(x))
+
+        def rigid(xo, xi):
+            t = 1 / np.sqrt(mu * L)
+            return [(t, t)] if self.bc == "free-free" else []
+
+        return w, fields, mu, 0.0, rigid
 
     def modes(self, n: int = 3) -> ModalEstimate:
         """The first n modes.
@@ -116,6 +141,8 @@ class Shaft(Rod):
         Boundary conditions, as a rod's.
     zeta : float
         Modal damping ratio.
+    J : float, optional
+        Polar moment of the section in m^4 (needed for modal inertias and the FRF, then in rad/(N m)).
 
     Raises
     ------
@@ -130,12 +157,12 @@ class Shaft(Rod):
     2
     """
 
-    def __init__(self, *, G, rho, L, bc="fixed-free", zeta=0.0):
-        super().__init__(E=G, rho=rho, L=L, bc=bc, zeta=zeta)
+    def __init__(self, *, G, rho, L, bc="fixed-free", zeta=0.0, J=None):
+        super().__init__(E=G, rho=rho, L=L, bc=bc, zeta=zeta, A=J)
 
 
-class String:
-    """A taut string: fn = n / (2 L) sqrt(T / mu).
+class String(ModalExpansion):
+    """A taut string: fn = n / (2 L) sqrt(T / mu); its forced response by modal expansion.
 
     Parameters
     ----------
@@ -163,8 +190,16 @@ class String:
 
     def __init__(self, *, T, mu, L, zeta=0.0):
         self.c = np.sqrt(positive(T, "T") / positive(mu, "mu"))
-        self.L = positive(L, "L")
+        self.mu, self.L = float(mu), positive(L, "L")
         self.zeta = zeta
+
+    def _modal_set(self, n):
+        k = np.arange(1, n + 1)
+
+        def fields(r, x):
+            return np.sin(k[r] * np.pi * np.asarray(x, float) / self.L), np.zeros(np.shape(x))
+
+        return 2 * np.pi * self.modes(n).fn, fields, self.mu, 0.0, lambda xo, xi: []
 
     def modes(self, n: int = 3) -> ModalEstimate:
         """The first n modes.
@@ -245,8 +280,9 @@ def beta_l(bc: str, n: int = 3) -> np.ndarray:
     return np.array(roots)
 
 
-class Beam:
-    """Euler-Bernoulli beam: fn = (beta L)^2 / (2 pi L^2) sqrt(E I / (rho A)).
+class Beam(SectionModes, ModalExpansion):
+    """Euler-Bernoulli beam: fn = (beta L)^2 / (2 pi L^2) sqrt(E I / (rho A)); its forced response by modal
+    expansion (``RayleighBeam`` and ``TimoshenkoBeam`` add rotary inertia and shear).
 
     Parameters
     ----------
@@ -287,6 +323,9 @@ class Beam:
             raise ParameterError(f"bc={bc!r} must be one of {tuple(_CHAR)}")
         self.bc, self.zeta = bc, zeta
 
+    def _section(self):
+        return _Section(self.EI, self.m, 0.0, None, self.L, self.bc)
+
     def modes(self, n: int = 3) -> ModalEstimate:
         """The first n modes.
 
@@ -317,7 +356,7 @@ class Beam:
         return _est(fn, self.zeta, f"beam {self.bc}")
 
     def shape(self, mode: int, x) -> np.ndarray:
-        """Mode shape (unit maximum) at positions x.
+        """Mode shape at positions x, scaled to a largest displacement of 1 over the whole beam.
 
         Parameters
         ----------
@@ -343,245 +382,8 @@ class Beam:
         >>> round(float(abs(b.shape(1, [1.0])[0])), 3)      # the free tip moves most
         1.0
         """
-        b = beta_l(self.bc, mode)[-1] / self.L
         x = np.asarray(x, float)
-        if self.bc == "simply-supported":
-            y = np.sin(b * x)
-        else:
-            bl = b * self.L
-            if self.bc in ("cantilever",):
-                s = (np.cos(bl) + np.cosh(bl)) / (np.sin(bl) + np.sinh(bl))
-                y = np.cosh(b * x) - np.cos(b * x) - s * (np.sinh(b * x) - np.sin(b * x))
-            elif self.bc == "free-free":
-                s = (np.cos(bl) - np.cosh(bl)) / (np.sin(bl) - np.sinh(bl))
-                y = np.cosh(b * x) + np.cos(b * x) - s * (np.sinh(b * x) + np.sin(b * x))
-            else:  # clamped-clamped, clamped-pinned
-                s = (np.cos(bl) - np.cosh(bl)) / (np.sin(bl) - np.sinh(bl))
-                y = np.cosh(b * x) - np.cos(b * x) - s * (np.sinh(b * x) - np.sin(b * x))
-        return y / np.max(np.abs(y))
-
-
-def stiffness(kind: str, **p) -> float:
-    """Equivalent stiffness of common elements (N/m, or N m/rad for torsion).
-
-    rod EA/L, cantilever tip 3EI/L^3, simply supported midspan 48EI/L^3, clamped-clamped midspan
-    192EI/L^3, torsion GJ/L, coil spring G d^4 / (8 D^3 n).
-
-    Parameters
-    ----------
-    kind : str
-        "rod", "cantilever", "simply-supported", "clamped-clamped", "torsion" or "coil".
-    **p : float
-        The element's parameters by name (E, A, I, L, G, J, d, D, n).
-
-    Returns
-    -------
-    float
-
-    Raises
-    ------
-    ParameterError
-        For an unknown kind, or a parameter missing or not positive.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import vibmeasure as vm
-    >>> vm.models.stiffness("cantilever", E=210e9, I=1e-8, L=1.0)
-    6300.0
-    """
-    forms = {
-        "rod": (("E", "A", "L"), lambda E, A, L: E * A / L),
-        "cantilever": (("E", "I", "L"), lambda E, I, L: 3 * E * I / L ** 3),
-        "simply-supported": (("E", "I", "L"), lambda E, I, L: 48 * E * I / L ** 3),
-        "clamped-clamped": (("E", "I", "L"), lambda E, I, L: 192 * E * I / L ** 3),
-        "torsion": (("G", "J", "L"), lambda G, J, L: G * J / L),
-        "coil-spring": (("G", "d", "D", "n"), lambda G, d, D, n: G * d ** 4 / (8 * D ** 3 * n)),
-    }
-    if kind not in forms:
-        raise ParameterError(f"kind={kind!r} must be one of {tuple(forms)}")
-    names, f = forms[kind]
-    missing = [nm for nm in names if nm not in p]
-    extra = [nm for nm in p if nm not in names]
-    if missing or extra:
-        raise ParameterError(f"stiffness {kind!r} needs exactly {names}; missing {missing}, unknown {extra}")
-    return float(f(*(positive(p[nm], nm) for nm in names)))
-
-
-def series(*k) -> float:
-    """Springs in series: 1 / sum(1/k).
-
-    Parameters
-    ----------
-    *k : float
-        Stiffnesses.
-
-    Returns
-    -------
-    float
-
-    Raises
-    ------
-    ParameterError
-        For a stiffness that is not positive.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import vibmeasure as vm
-    >>> vm.models.series(2e3, 2e3)
-    1000.0
-    """
-    return float(1 / sum(1 / positive(x, "k") for x in k))
-
-
-def parallel(*k) -> float:
-    """Springs in parallel: sum(k).
-
-    Parameters
-    ----------
-    *k : float
-        Stiffnesses.
-
-    Returns
-    -------
-    float
-
-    Raises
-    ------
-    ParameterError
-        For a stiffness that is not positive.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import vibmeasure as vm
-    >>> vm.models.parallel(1e3, 2e3)
-    3000.0
-    """
-    return float(sum(positive(x, "k") for x in k))
-
-
-def pendulum_period(length: float, g: float = _G0) -> float:
-    """Small-angle period of a simple pendulum, 2 pi sqrt(L / g).
-
-    Parameters
-    ----------
-    length : float
-        Length in m.
-    g : float
-        Gravity in m/s^2.
-
-    Returns
-    -------
-    float
-        s.
-
-    Raises
-    ------
-    ParameterError
-        For values that are not positive.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import vibmeasure as vm
-    >>> round(vm.models.pendulum_period(1.0), 3)
-    2.006
-    """
-    return float(2 * np.pi * np.sqrt(positive(length, "length") / positive(g, "g")))
-
-
-def pendulum_gravity(length: float, period: float) -> float:
-    """Gravity from a simple pendulum's length and measured period: 4 pi^2 L / T^2.
-
-    Parameters
-    ----------
-    length : float
-        Length in m.
-    period : float
-        Measured period in s.
-
-    Returns
-    -------
-    float
-        m/s^2.
-
-    Raises
-    ------
-    ParameterError
-        For values that are not positive.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import vibmeasure as vm
-    >>> round(vm.models.pendulum_gravity(1.0, 2.006), 2)
-    9.81
-    """
-    return float(4 * np.pi ** 2 * positive(length, "length") / positive(period, "period") ** 2)
-
-
-def compound_pendulum_fn(*, mass: float, inertia_pivot: float, distance: float, g: float = _G0) -> float:
-    """Natural frequency of a compound pendulum: sqrt(m g d / I_pivot) / 2 pi.
-
-    Parameters
-    ----------
-    mass : float
-        Mass in kg.
-    inertia_pivot : float
-        Moment of inertia about the pivot in kg m^2.
-    distance : float
-        Pivot to centre of mass in m.
-    g : float
-        Gravity in m/s^2.
-
-    Returns
-    -------
-    float
-        Hz.
-
-    Raises
-    ------
-    ParameterError
-        For values that are not positive.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import vibmeasure as vm
-    >>> round(vm.models.compound_pendulum_fn(mass=1.0, inertia_pivot=1.0, distance=1.0), 3)
-    0.498
-    """
-    return float(np.sqrt(positive(mass, "mass") * positive(g, "g") * positive(distance, "distance")
-                         / positive(inertia_pivot, "inertia_pivot")) / (2 * np.pi))
-
-
-def whirling_speed_rpm(*, k: float, m: float) -> float:
-    """Critical (whirling) speed of a disc on a shaft, in rpm.
-
-    Parameters
-    ----------
-    k : float
-        Lateral stiffness of the shaft in N/m.
-    m : float
-        Mass of the disc in kg.
-
-    Returns
-    -------
-    float
-        rpm.
-
-    Raises
-    ------
-    ParameterError
-        For values that are not positive.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> import vibmeasure as vm
-    >>> round(vm.models.whirling_speed_rpm(k=3947.84, m=1.0), 0)
-    600.0
-    """
-    return float(np.sqrt(positive(k, "k") / positive(m, "m")) * 60 / (2 * np.pi))
+        if np.any((x < 0) | (x > self.L)) or not np.all(np.isfinite(x)):
+            raise ParameterError(f"x must lie on the beam (0 .. L = {self.L:g} m)")
+        w = 2 * np.pi * self.modes(_n(mode)).fn[-1]
+        return self._section().fields(w, x)[0]

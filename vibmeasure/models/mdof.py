@@ -291,8 +291,7 @@ class MDOF:
         F = np.asarray(force, float)
         if F.shape != (self.n_dof, t.size):
             raise ParameterError(f"force must have shape ({self.n_dof}, {t.size}), got {F.shape}")
-        x0 = np.zeros(self.n_dof) if x0 is None else np.asarray(x0, float)
-        v0 = np.zeros(self.n_dof) if v0 is None else np.asarray(v0, float)
+        x0, v0 = self._initial(x0, "x0"), self._initial(v0, "v0")
         if self.is_proportional():
             phi, w = self._phi, self._w
             c = np.diag(phi.T @ self.C @ phi)
@@ -311,6 +310,19 @@ class MDOF:
         _, y, _ = lsim((A, B, np.hstack([np.eye(n), np.zeros((n, n))]), np.zeros((n, n))), F.T, t,
                        X0=np.r_[x0, v0])
         return y.T
+
+    def _initial(self, value, name: str) -> np.ndarray:
+        """An initial state: zeros when not given, else n_dof finite numbers."""
+        if value is None:
+            return np.zeros(self.n_dof)
+        try:
+            v = np.asarray(value, float).reshape(-1)
+        except (TypeError, ValueError):
+            raise ParameterError(f"{name} must be {self.n_dof} numbers") from None
+        if v.size != self.n_dof or not np.all(np.isfinite(v)):
+            raise ParameterError(f"{name} must be {self.n_dof} finite numbers (one per degree of freedom), "
+                                 f"got {np.asarray(value).shape}")
+        return v
 
     def scaled(self, *, k_scale: float = 1.0, c_scale: float = 1.0) -> "MDOF":
         """The same system with K (and C) multiplied by scale factors (model updating).

@@ -2,6 +2,11 @@
 
 x'' m + c x' + k x = F(t) (viscous) or k (1 + i eta) for structural (hysteretic) damping in
 harmonic response; Coulomb (dry friction) free response by its closed form.
+
+Hysteretic damping has one definition across every property: the FRF and the harmonic responses use
+k (1 + i eta) exactly; everything else (zeta, Q, the log decrement, the free and transient responses,
+``modes()``) uses its equivalent viscous damping at resonance, zeta = eta / 2 (c = eta k / wn), because
+a loss factor independent of frequency has no causal time-domain form.
 """
 
 from __future__ import annotations
@@ -84,8 +89,10 @@ def coulomb_response(t, *, fn: float, friction_decay: float, amplitude: float, o
 class SDOF(_Transient):
     """A mass-spring-damper m x'' + c x' + k x = f.
 
-    Properties: wn (rad/s), fn, fd (Hz), c_crit, zeta, c, Td, log_decrement, Q, regime. A loss factor
-    (hysteretic damping) enters the FRF as k (1 + i eta).
+    Properties: wn (rad/s), fn, fd (Hz), c_crit, zeta, c, c_equivalent, Td, log_decrement, Q, regime.
+    A loss factor (hysteretic damping) enters the FRF as k (1 + i eta) and every other property as its
+    equivalent viscous damping at resonance: zeta = c / c_crit + eta / 2, so Q = 1 / eta for a loss
+    factor alone (the FRF's peak magnification).
 
     Parameters
     ----------
@@ -94,7 +101,7 @@ class SDOF(_Transient):
     k : float
         Stiffness in N/m.
     c : float, optional
-        Viscous damping in N s/m (give one of c, zeta, loss_factor).
+        Viscous damping in N s/m (give c or zeta; a loss factor may come with either).
     zeta : float, optional
         Damping ratio.
     loss_factor : float, optional
@@ -118,17 +125,21 @@ class SDOF(_Transient):
                  loss_factor: float | None = None):
         self.m = positive(m, "m")
         self.k = positive(k, "k")
-        given = [x is not None for x in (c, zeta, loss_factor)]
-        if sum(given) > 1:
-            raise ParameterError("give one of c, zeta and loss_factor, not several")
+        if c is not None and zeta is not None:
+            raise ParameterError("give one of c and zeta, not both (a loss_factor may come with either)")
         self.c_crit = 2 * np.sqrt(self.k * self.m)
         self.loss_factor = 0.0 if loss_factor is None else positive(loss_factor, "loss_factor", allow_zero=True)
         if zeta is not None:
-            self.zeta = positive(zeta, "zeta", allow_zero=True)
-            self.c = self.zeta * self.c_crit
+            self.c = positive(zeta, "zeta", allow_zero=True) * self.c_crit
         else:
             self.c = 0.0 if c is None else positive(c, "c", allow_zero=True)
-            self.zeta = self.c / self.c_crit
+        # the viscous part plus the loss factor's equivalent at resonance (module docstring)
+        self.zeta = self.c / self.c_crit + self.loss_factor / 2
+
+    @property
+    def c_equivalent(self) -> float:
+        """Viscous c plus the loss factor's equivalent at resonance, eta k / wn (N s/m)."""
+        return self.zeta * self.c_crit
 
     # --- natural properties --------------------------------------------------------------------
     @property
@@ -165,7 +176,7 @@ class SDOF(_Transient):
 
     @property
     def Q(self) -> float:
-        return np.inf if self.zeta == 0 else 1 / (2 * self.zeta)
+        return np.inf if self.zeta == 0 else float(1 / (2 * self.zeta))
 
     @property
     def regime(self) -> str:
@@ -192,8 +203,7 @@ class SDOF(_Transient):
         >>> round(float(s.modes().fn[0]), 3)
         10.0
         """
-        z = self.zeta if self.loss_factor == 0 else self.loss_factor / 2
-        return ModalEstimate(fn=[self.fn], zeta=[z], fn_std=[0.0], zeta_std=[0.0], method="model:sdof",
+        return ModalEstimate(fn=[self.fn], zeta=[self.zeta], fn_std=[0.0], zeta_std=[0.0], method="model:sdof",
                              extras={"m": self.m, "k": self.k, "c": self.c, "loss_factor": self.loss_factor})
 
     # --- free response -------------------------------------------------------------------------
@@ -524,7 +534,8 @@ class SDOF(_Transient):
         return positive(me, "me") * w ** 2 * np.abs(self.frf(freq))
 
     def __repr__(self) -> str:
-        return f"SDOF(m={self.m:g}, k={self.k:g}, c={self.c:g}; fn={self.fn:.5g} Hz, zeta={self.zeta:.4g})"
+        eta = f", loss_factor={self.loss_factor:g}" if self.loss_factor else ""
+        return f"SDOF(m={self.m:g}, k={self.k:g}, c={self.c:g}{eta}; fn={self.fn:.5g} Hz, zeta={self.zeta:.4g})"
 
 
 def stiffness_for(fn: float, m: float) -> float:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core._validate import positive
+from ..core._validate import finite_number, positive
 from ..core.errors import ParameterError
 
 
@@ -100,9 +100,10 @@ class _Transient:
         return rate / self.k * (t - 2 * self.zeta / self.wn + self.free_response(t, x0=2 * self.zeta / self.wn,
                                                                                v0=-1.0))
 
-    def response(self, t, force) -> np.ndarray:
-        """Displacement under an arbitrary force sampled at times t, from rest, by exact state-space
-        integration with the force linear between samples.
+    def response(self, t, force, *, x0: float = 0.0, v0: float = 0.0) -> np.ndarray:
+        """Displacement under an arbitrary force sampled at times t, starting from x0, v0 (the forced
+        response plus the free response), by exact state-space integration with the force linear between
+        samples. A loss factor acts as its equivalent viscous damping at resonance.
 
         Parameters
         ----------
@@ -110,6 +111,10 @@ class _Transient:
             Uniform times in s.
         force : array_like
             Force samples in N.
+        x0 : float
+            Displacement at t[0] in m.
+        v0 : float
+            Velocity at t[0] in m/s.
 
         Returns
         -------
@@ -118,7 +123,8 @@ class _Transient:
         Raises
         ------
         ParameterError
-            For times that are not uniform or a force of another length.
+            For times that are not uniform, a force of another length or initial conditions that are not
+            finite.
 
         Examples
         --------
@@ -128,14 +134,19 @@ class _Transient:
         >>> t = np.arange(20000) / 1000.0
         >>> round(float(s.response(t, np.ones(t.size))[-1] * 3947.84), 3)
         1.0
+        >>> round(float(s.response(t[:1], [0.0], x0=0.002)[0]), 6)      # starts where it is released
+        0.002
         """
         from scipy.signal import lsim
         t = np.asarray(t, float)
         force = np.asarray(force, float)
         if force.shape != t.shape:
             raise ParameterError(f"force has shape {force.shape}; it must match t {t.shape}")
-        A = [[0.0, 1.0], [-self.k / self.m, -self.c / self.m]]
-        _, y, _ = lsim((A, [[0.0], [1.0 / self.m]], [[1.0, 0.0]], [[0.0]]), force, t)
+        x0, v0 = finite_number(x0, "x0"), finite_number(v0, "v0")
+        if t.size == 1:   # lsim needs two samples; at t[0] the state is the initial one
+            return np.array([x0])
+        A = [[0.0, 1.0], [-self.k / self.m, -self.c_equivalent / self.m]]
+        _, y, _ = lsim((A, [[0.0], [1.0 / self.m]], [[1.0, 0.0]], [[0.0]]), force, t, X0=[x0, v0])
         return y
 
     def periodic_response(self, t, *, period: float, a0: float = 0.0, a=(), b=()) -> np.ndarray:

@@ -31,6 +31,11 @@ FLAG_TEXT = {
     "colored_noise": "the noise near this mode is stronger than the broadband level: std scaled up",
     "low_snr": "the mode is weak compared with the noise",
     "start_detected": "the decay starts after the beginning of the record (trigger/impact found)",
+    "one_cycle": "only one whole cycle: no spread between cycles, so no std",
+    "amplitude_varies": "the amplitude changes by more than 5 % from cycle to cycle: not a steady state, the "
+                        "loop's area mixes amplitudes",
+    "not_harmonic": "the motion is not one sinusoid (harmonics above 5 %): the equivalent viscous c assumes "
+                    "harmonic motion and holds only as an energy equivalent",
     # machine diagnosis
     "bearing_not_checked": "no bearing given: bearing faults were not searched",
     "band_limited": "a channel measures only up to a filter's edge, too low to demodulate above the shaft "
