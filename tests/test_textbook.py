@@ -376,3 +376,18 @@ def test_anti_resonances_against_the_chain_with_the_driven_mass_held():
     assert cross["antiresonances"].size == 0 and not cross["alternates"]
     with pytest.warns(vm.QualityWarning, match="driving-point FRF alternates"):
         vm.antiresonances(vm.FRF(freq=f, h=H[2, 0]))
+
+
+def test_model_files_take_the_new_beams_and_refuse_truth_values(tmp_path):
+    p = tmp_path / "t.toml"
+    p.write_text('type = "timoshenko_beam"\n[parameters]\nE = "210 GPa"\nI = "8.33e6 mm^4"\nrho = "7850 kg/m^3"\n'
+                 'A = "10000 mm^2"\nL = "0.5 m"\nnu = 0.3\nzeta = 0.01\n')
+    tb = M.load(p)
+    ref = M.TimoshenkoBeam(E=210e9, I=8.33e-6, rho=7850.0, A=0.01, L=0.5, nu=0.3)
+    assert tb.modes(2).fn == pytest.approx(ref.modes(2).fn, rel=1e-12)
+    p.write_text('type = "sdof"\n[parameters]\nm = "1 kg"\nk = "1 N/m"\nzeta = true\n')
+    with pytest.raises(vm.ParameterError, match="truth value"):
+        M.load(p)
+    p.write_text('type = "sdof"\n[parameters]\nm = "1 kg"\nk = "1 N/m"\nzeta = ' + "9" * 4000 + "\n")
+    with pytest.raises(vm.ParameterError, match="zeta"):
+        M.load(p)

@@ -34,5 +34,6 @@ def run(args, out, err) -> int:
 
 def predict(model, n):
     """The modes a model predicts: n modes of a continuum, every mode of a discrete model."""
-    from ..models.continua import Beam, Rod, String
-    return model.modes(n) if isinstance(model, (Beam, Rod, String)) else model.modes()
+    from ..models import Beam, RayleighBeam, Rod, String, TimoshenkoBeam
+    continua = (Beam, RayleighBeam, TimoshenkoBeam, Rod, String)
+    return model.modes(n) if isinstance(model, continua) else model.modes()

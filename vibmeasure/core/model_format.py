@@ -4,11 +4,11 @@ TOML_FORMAT = """\
 model file format (TOML): a type and a [parameters] table; every dimensional parameter carries its
 unit as "number unit" or { value = ..., unit = "..." }; dimensionless ones are plain numbers.
 
-  type = "sdof"                         # sdof | mdof | beam | rod | shaft | string
+  type = "sdof"                # sdof | mdof | beam | rayleigh_beam | timoshenko_beam | rod | shaft | string
   [parameters]
   m = "200 kg"
   k = "40 N/mm"
-  zeta = 0.22                           # or c = "500 N s/m", or loss_factor = 0.02
+  zeta = 0.22                           # or c = "500 N s/m"; loss_factor = 0.02 alone or added
 
   type = "mdof"
   [parameters]
@@ -26,8 +26,9 @@ unit as "number unit" or { value = ..., unit = "..." }; dimensionless ones are p
   bc = "cantilever"                     # cantilever | simply-supported | clamped-clamped | free-free | clamped-pinned
   zeta = 0.01
 
-  rod: E, rho, L, bc (fixed-free | fixed-fixed | free-free), zeta;  shaft: G, rho, L, bc, zeta;
-  string: T (N), mu (kg/m), L, zeta.
+  rayleigh_beam: as beam (adds rotary inertia); timoshenko_beam: as beam plus G (or nu) and kappa
+  (shear coefficient, 5/6 for a rectangle); rod: E, rho, L, bc (fixed-free | fixed-fixed | free-free),
+  zeta, A (for its FRF); shaft: G, rho, L, bc, zeta, J; string: T (N), mu (kg/m), L, zeta.
 
 units: mass kg g t lb; stiffness N/m N/mm kN/m kN/mm lbf/in; damping N s/m kN s/m; length m mm cm in;
 modulus Pa kPa MPa GPa; density kg/m^3 g/cm^3; area m^2 mm^2; second moment m^4 mm^4; force N;

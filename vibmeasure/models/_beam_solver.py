@@ -50,7 +50,11 @@ class _Section:
             a = self.kGA * self.EI
             b = w2 * (self.kGA * self.rhoI + self.rhoA * self.EI)
             c = self.rhoA * w2 * (self.rhoI * w2 - self.kGA)
-        return np.roots([a, b, c])
+        # real roots of opposite sign below the cut-off (c < 0), both negative above it; the stable form
+        # q = -(b + sign(b) sqrt(disc)) / 2 keeps the small root's digits
+        disc = np.sqrt(max(b * b - 4 * a * c, 0.0))
+        q = -(b + (disc if b >= 0 else -disc)) / 2
+        return np.array([q / a, c / q if q != 0 else 0.0])
 
     def _ends(self, s, w):
         """(w, psi, M, V) of the solution e^(s x) with unit amplitude (s may be complex)."""

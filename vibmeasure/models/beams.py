@@ -29,6 +29,10 @@ class _BeamTheory(SectionModes, ModalExpansion):
             raise ParameterError(f"bc={bc!r} must be one of {tuple(_CHAR)}")
         self.bc, self.zeta = bc, zeta
 
+    def __repr__(self) -> str:
+        return (f"{type(self).__name__}(E={self.E:g}, I={self.I:g}, rho={self.rho:g}, A={self.A:g}, L={self.L:g}, "
+                f"bc={self.bc!r}; L/r={self.slenderness:.4g})")
+
     @property
     def slenderness(self) -> float:
         """L / r with r = sqrt(I / A) the radius of gyration of the section."""

@@ -326,6 +326,9 @@ class Beam(SectionModes, ModalExpansion):
     def _section(self):
         return _Section(self.EI, self.m, 0.0, None, self.L, self.bc)
 
+    def __repr__(self) -> str:
+        return f"Beam(EI={self.EI:g}, rho A={self.m:g}, L={self.L:g}, bc={self.bc!r})"
+
     def modes(self, n: int = 3) -> ModalEstimate:
         """The first n modes.
 

@@ -28,14 +28,24 @@ _NEEDS = {  # parameter -> dimensions it may have
     "m": ("mass", "inertia"), "k": ("stiffness", "torsional_stiffness"), "c": ("damping", "torsional_damping"),
     "M": ("mass", "inertia"), "K": ("stiffness", "torsional_stiffness"), "C": ("damping", "torsional_damping"),
     "E": ("pressure",), "G": ("pressure",), "rho": ("density",), "A": ("area",), "I": ("second_moment",),
-    "L": ("length",), "T": ("force",), "mu": ("linear_density",),
+    "L": ("length",), "T": ("force",), "mu": ("linear_density",), "J": ("second_moment",),
 }
-_PLAIN = {"zeta", "loss_factor", "modal_zeta", "rayleigh", "bc", "n_modes"}
-_TYPES = {"sdof", "mdof", "beam", "rod", "shaft", "string"}
+_PLAIN = {"zeta", "loss_factor", "modal_zeta", "rayleigh", "bc", "n_modes", "nu", "kappa"}
+_TYPES = {"sdof", "mdof", "beam", "rayleigh_beam", "timoshenko_beam", "rod", "shaft", "string"}
 
 
 def _quantity(name, v, src):
     if name in _PLAIN:
+        if name == "bc":
+            return v
+        if isinstance(v, bool):
+            raise ParameterError(f"{src}: parameter {name} = {str(v).lower()} must be a number, not a truth value")
+        try:
+            ok = np.all(np.isfinite(np.asarray(v, float)))
+        except (TypeError, ValueError, OverflowError):
+            ok = False
+        if not ok:
+            raise ParameterError(f"{src}: parameter {name} = {str(v)[:40]!r} must be a finite number (or list of them)")
         return v
     if name not in _NEEDS:
         raise ParameterError(f"{src}: parameter {name!r} is not known; known: {sorted(set(_NEEDS) | _PLAIN)}")
@@ -100,7 +110,7 @@ def load(path) -> object:
 
     Returns
     -------
-    SDOF, MDOF, Beam, Rod, Shaft or String
+    SDOF, MDOF, Beam, RayleighBeam, TimoshenkoBeam, Rod, Shaft or String
 
     Raises
     ------
@@ -119,6 +129,7 @@ def load(path) -> object:
     23.7
     """
     import tomllib
+    from .beams import RayleighBeam, TimoshenkoBeam
     from .continua import Beam, Rod, Shaft, String
     from .mdof import MDOF
     from .sdof import SDOF
@@ -142,7 +153,7 @@ def load(path) -> object:
     if not isinstance(raw, dict) or not raw:
         raise ParameterError(f"{src}: a [parameters] table is required")
     par = {k: _quantity(k, v, src) for k, v in raw.items()}
-    if kind in ("sdof", "beam", "rod", "shaft", "string") and not {"zeta", "c", "loss_factor"} & set(par) or \
+    if kind not in ("mdof",) and not {"zeta", "c", "loss_factor"} & set(par) or \
             kind == "mdof" and not {"C", "rayleigh", "modal_zeta"} & set(par):
         import warnings
         from ..core.errors import QualityWarning
@@ -153,14 +164,15 @@ def load(path) -> object:
             return SDOF(**{k: float(v) for k, v in par.items()})
         if kind == "mdof":
             return MDOF(**par)
-        if kind == "beam":
-            return Beam(**{k: (v if k == "bc" else float(v)) for k, v in par.items()})
+        beams = {"beam": Beam, "rayleigh_beam": RayleighBeam, "timoshenko_beam": TimoshenkoBeam}
+        if kind in beams:
+            return beams[kind](**{k: (v if k == "bc" else float(v)) for k, v in par.items()})
         if kind == "rod":
             return Rod(**{k: (v if k == "bc" else float(v)) for k, v in par.items()})
         if kind == "shaft":
             return Shaft(**{k: (v if k == "bc" else float(v)) for k, v in par.items()})
         return String(**{k: float(v) for k, v in par.items()})
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         if isinstance(exc, ParameterError):
             raise
-        raise ParameterError(f"{src}: parameters do not fit a {kind} model: {exc}") from None
+        raise ParameterError(f"{src}: parameters do not fit a {kind} model: {str(exc)[:200]}") from None
