@@ -309,8 +309,9 @@ def test_manifest_rules(tmp_path):
     with pytest.raises(vm.ParameterError, match=r"unknown column\(s\) \['speed'\]"):
         vm.read_manifest(tmp_path / "m.csv")
     (tmp_path / "m.csv").write_text("file,asset\nnothing*.h5,a\n")
-    with pytest.raises(vm.ParameterError, match="no file matches 'nothing\\*.h5'"):
-        vm.read_manifest(tmp_path / "m.csv")
+    # a row's own rule breaks that row only: it comes back as an error item
+    [row] = vm.read_manifest(tmp_path / "m.csv")
+    assert "no file matches 'nothing*.h5'" in row["error"]
     with pytest.raises(vm.ParameterError, match="task='fft' must be one of"):
         vm.batch(tmp_path, task="fft", store=tmp_path / "s.h5")
 
@@ -328,8 +329,8 @@ def test_a_manifest_names_the_tachometer_of_run_ups(tmp_path):
     diag = vm.Store(tmp_path / "s.h5").results("diagnose")
     assert dict(zip(diag["asset"], diag["top"])) == {"a": "bearing_inner_race", "b": "none"}
     (tmp_path / "in" / "bad.csv").write_text("file,asset,tach,pulses_per_rev\nr0.h5,a,tach,two\n")
-    with pytest.raises(vm.ParameterError, match="pulses_per_rev='two' is not a whole number"):
-        vm.read_manifest(tmp_path / "in" / "bad.csv")
+    [row] = vm.read_manifest(tmp_path / "in" / "bad.csv")
+    assert "pulses_per_rev='two' is not a whole number" in row["error"]
 
 
 @pytest.fixture(scope="module")
@@ -482,3 +483,79 @@ def test_cli_batch_fails_when_every_input_failed_and_ctrl_c_is_one_line(tmp_path
     assert proc.returncode == 130 and "Traceback" not in errs, errs[-800:]
     n = int(re.search(r"interrupted: (\d+) of 40 stored", errs).group(1))
     assert vm.Store(tmp_path / "big.db").n_measurements == n   # what it said it stored is there
+
+
+def _one_row_store(path):
+    with vm.Store(path, writable=True) as st:
+        st.add_asset("pump-1")
+        st.add_point("pump-1", "DE")
+        mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797,
+                                 record=vm.synth.machine(rpm=1797, duration=0.2, seed=1), keep_raw=True)
+        st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+    return mid
+
+
+@pytest.mark.parametrize("kind", ["external_link", "external_storage", "virtual"])
+def test_a_resealed_store_with_links_out_of_its_file_is_refused(tmp_path, kind):
+    """Issue 48: an object that reads or writes another file is refused on opening, even past a valid seal."""
+    from vibmeasure.io.hdf5 import seal
+    p = tmp_path / "plant.h5"
+    _one_row_store(p)
+    other = tmp_path / "other.bin"
+    other.write_bytes(b"secret" * 100)
+    with h5py.File(p, "a") as f:
+        if kind == "external_link":
+            f["raw_extra"] = h5py.ExternalLink(str(other), "/x")
+        elif kind == "external_storage":
+            f.create_dataset("raw_extra", shape=(100,), dtype="u1", external=[(str(other), 0, 100)])
+        else:
+            layout = h5py.VirtualLayout(shape=(10,), dtype="f8")
+            layout[:] = h5py.VirtualSource(str(other), "x", shape=(10,))
+            f.create_virtual_dataset("raw_extra", layout)
+    seal(p)
+    with pytest.raises(vm.ParameterError, match="refused"):
+        vm.Store(p)
+
+
+def test_a_symlinked_store_locks_and_writes_the_real_file(tmp_path):
+    """Issue 48: both names of one store exclude each other, and a commit leaves the link a link."""
+    real, link = tmp_path / "plant.h5", tmp_path / "alias.h5"
+    _one_row_store(real)
+    link.symlink_to(real)
+    with vm.Store(link, writable=True) as st:
+        with pytest.raises(vm.StoreLockedError):
+            vm.Store(real, writable=True)
+        st.add_measurement("pump-1", "DE", time="2026-11-22T09:00", rpm=1797)
+    assert link.is_symlink()
+    assert vm.Store(real).n_measurements == 2
+    fifo = tmp_path / "fifo.h5"
+    os.mkfifo(fifo)
+    with pytest.raises(vm.ParameterError, match="FIFO"):
+        vm.Store(fifo)
+
+
+def test_a_bad_manifest_row_is_its_own_error_and_the_batch_goes_on(tmp_path):
+    """Issue 48: rpm NaN or negative, an unparsable time, a long or multi-line name: each row an error with
+    its line and rule; the good rows are analysed."""
+    vm.synth.fleet(tmp_path, n_measurements=2)
+    good = (tmp_path / "machines.csv").read_text().splitlines()[1:]
+    f1, f2, f3 = (line.split(",")[0] for line in good[:3])
+    m = tmp_path / "bad.csv"
+    m.write_text("file,asset,point,time,rpm\n"
+                 f"{f1},pump-1,DE,2026-01-05T00:00:00,1484\n"
+                 f"{f2},pump-2,DE,2026-01-05T00:00:00,nan\n"
+                 f"{f3},pump-3,DE,someday,1465\n"
+                 f'{f1},"pump\nfour",DE,2026-01-05T00:00:00,1484\n'
+                 f"{f2},{'x' * 300},DE,2026-01-05T00:00:00,1466\n"
+                 f"{f3},pump-3,DE,2026-01-05T00:00:00,-5\n")
+    rep = vm.batch(manifest=m, store=tmp_path / "s.db")
+    assert (rep["status"] == "done").sum() == 1
+    errors = rep[rep["status"] == "error"]["message"].tolist()
+    assert len(errors) == 5
+    for rule in ("row 3 (the header is row 1): rpm=nan", "row 4 (the header is row 1): time='someday'",
+                 "row 5 (the header is row 1): asset=", "row 6 (the header is row 1): asset=",
+                 "row 7 (the header is row 1): rpm=-5.0"):
+        assert any(rule in e for e in errors), (rule, errors)
+    m.write_bytes(b"file,asset\n\xff\xfe.h5,a\n")
+    with pytest.raises(vm.ParameterError, match="not UTF-8"):
+        vm.read_manifest(m)

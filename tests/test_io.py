@@ -483,3 +483,14 @@ def test_a_24_bit_pcm_wav_reads_at_full_scale(tmp_path):
     r = vm.read(p)
     assert r.fs == fs and r.n_samples == n
     np.testing.assert_array_equal(r.data[0], ints / 2.0 ** 23)   # exact: 24-bit integers over 2^23
+
+
+def test_a_mat_file_that_inflates_past_the_limit_is_refused_before_it_is_decompressed(tmp_path):
+    """Issue 48: a struct field is not in whosmat; its inflated size is read from the compressed element's
+    own tag. 160 MB of zeros compress to 156 kB."""
+    import scipy.io as sio
+    p = tmp_path / "bomb.mat"
+    sio.savemat(p, {"s": {"big": np.zeros((1, 20_000_000)), "fs": 1000.0}}, do_compression=True)
+    assert p.stat().st_size < 200_000
+    with pytest.raises(vm.ParameterError, match="decompressed, declares 20,000,0"):
+        vm.read(p, max_samples=1_000_000)

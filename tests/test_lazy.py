@@ -100,3 +100,49 @@ def test_streamed_envelope_refuses_a_bad_nperseg(tmp_path):
     for bad, match in (("x", "integer"), (100, "at least 256")):
         with pytest.raises(vm.ParameterError, match=match):
             vm.envelope_spectrum(vm.open(p), band=(100, 300), nperseg=bad)
+
+
+def _crafted(path, *, data=None, names=("a", "b"), fs=100.0, meta="{}", drop=()):
+    """A record file in vibmeasure's schema, unsealed, with one part wrong."""
+    import h5py
+    data = np.zeros((2, 100)) if data is None else data
+    with h5py.File(path, "w") as f:
+        f.attrs["vibmeasure_schema"] = "vibmeasure.record"
+        f.attrs["schema_version"] = 1
+        f.attrs["meta"] = meta
+        d = f.create_dataset("data", data=data)
+        attrs = {"fs": fs, "t0": 0.0, "channel_names": list(names), "channel_quantities": ["unknown"] * len(names),
+                 "channel_units": [""] * len(names), "channel_locations": [""] * len(names)}
+        for k, v in attrs.items():
+            if k not in drop:
+                d.attrs[k] = v
+    return path
+
+
+@pytest.mark.parametrize("kw,rule", [
+    ({"drop": ("channel_names",)}, "damaged"),
+    ({"fs": "abc"}, "not a number"),
+    ({"fs": -5.0}, "must be > 0"),
+    ({"meta": "{not json"}, "damaged"),
+    ({"meta": "[1, 2]"}, "not a mapping"),
+    ({"data": np.zeros((2, 100)) + 1j}, "complex"),
+    ({"data": np.zeros((2, 0))}, "at least 2"),
+    ({"names": ("a", "b", "c")}, "3 channel descriptions"),
+])
+def test_the_lazy_path_is_as_strict_as_the_eager_one(tmp_path, kw, rule):
+    """Issue 48: each crafted record file ends in a ParameterError naming the rule, from vm.open as from vm.read."""
+    p = _crafted(tmp_path / "bad.h5", **kw)
+    with pytest.raises(vm.ParameterError, match=rule):
+        vm.open(p)
+    with pytest.raises(vm.ParameterError):
+        vm.read(p)
+
+
+def test_the_lazy_path_refuses_a_record_without_data(tmp_path):
+    import h5py
+    p = tmp_path / "nodata.h5"
+    with h5py.File(p, "w") as f:
+        f.attrs["vibmeasure_schema"] = "vibmeasure.record"
+    for reader in (vm.open, vm.read):
+        with pytest.raises(vm.ParameterError, match="data"):
+            reader(p)

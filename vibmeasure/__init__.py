@@ -85,7 +85,7 @@ _LAZY = {
     "Store": (".io.store", "Store"),
     "StoreLockedError": (".io.store", "StoreLockedError"),
     "batch": (".monitor.batch", "batch"),
-    "read_manifest": (".monitor.batch", "read_manifest"),
+    "read_manifest": (".monitor.inputs", "read_manifest"),
     "trend": (".monitor.trend", "trend"),
     "report": (".reporting", "report"),
     "models": (".", "models"),

@@ -192,26 +192,48 @@ def check_band(band, fs: float, *, name: str = "band") -> tuple[float, float] | 
     return lo, hi
 
 
-def finite_number(value, name: str) -> float:
-    """``value`` as a finite float; a bool, text or NaN is refused by name."""
+def regular_input(path, name: str = "path", *, max_bytes: int | None = None):
+    """``path`` as a Path to an existing regular file of at most ``max_bytes``: a folder, FIFO, device or
+    socket is refused by name before it is opened (reading /dev/zero or a FIFO never ends)."""
+    import stat
+    from pathlib import Path
+    p = Path(path)
+    try:
+        st = p.stat()
+    except FileNotFoundError:
+        raise ParameterError(f"{name}={str(path)!r} does not exist") from None
+    except OSError as exc:
+        raise ParameterError(f"{name}={str(path)!r} cannot be inspected: {exc.strerror or exc}") from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode)
+                else "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "a special file")
+        raise ParameterError(f"{name}={str(path)!r} is {kind}, not a file: the rule is, inputs are regular files")
+    if max_bytes is not None and st.st_size > max_bytes:
+        raise ParameterError(f"{name}={str(path)!r} is {st.st_size:,} bytes, above the {max_bytes:,} this input "
+                             "takes")
+    return p
+
+
+def _number(value, name: str) -> float:
+    """``value`` as a float; a bool or text is refused by name."""
     if isinstance(value, (bool, np.bool_)):
         raise ParameterError(f"{name}={value!r} must be a number, not a truth value")
     try:
-        v = float(value)
-    except (TypeError, ValueError):
+        return float(value)
+    except (TypeError, ValueError, OverflowError):
         raise ParameterError(f"{name}={value!r} must be a number") from None
+
+
+def finite_number(value, name: str) -> float:
+    """``value`` as a finite float; a bool, text or NaN is refused by name."""
+    v = _number(value, name)
     if not np.isfinite(v):
         raise ParameterError(f"{name}={value!r} must be finite")
     return v
 
 
 def positive(value, name: str, *, allow_zero: bool = False) -> float:
-    if isinstance(value, (bool, np.bool_)):
-        raise ParameterError(f"{name}={value!r} must be a number, not a truth value")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}={value!r} must be a number") from None
+    v = _number(value, name)
     if not np.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
         raise ParameterError(f"{name}={value!r} must be finite and {'>= 0' if allow_zero else '> 0'}")
     return v

@@ -7,6 +7,7 @@ import os
 import re
 from pathlib import Path
 
+from ..core._validate import regular_input
 from ..core.errors import ParameterError, UnitError
 from ..core.record import Record
 from ._common import DEFAULT_MAX_SAMPLES, check_max_samples
@@ -81,11 +82,7 @@ def read(path: str | os.PathLike, *, fs: float | None = None, channels=None, qua
     >>> vm.read(path).fs
     500.0
     """
-    p = Path(path)
-    if not p.exists():
-        raise ParameterError(f"path={str(path)!r} does not exist")
-    if p.is_dir():
-        raise ParameterError(f"path={str(path)!r} is a folder, not a file")
+    p = regular_input(path)
     ext = p.suffix.lower()
     if p.stat().st_size == 0:
         raise ParameterError(f"path={str(path)!r} is empty (0 bytes)")
@@ -232,9 +229,7 @@ def read_frf(path: str | os.PathLike, *, variable: str | None = None, fs: float 
     >>> frf = vm.read_frf("../shared/data/impact/case1.mat", variable="Hf_chan_2")  # doctest: +SKIP
     """
     from ..core.results import FRF
-    p = Path(path)
-    if not p.exists():
-        raise ParameterError(f"path={str(path)!r} does not exist")
+    p = regular_input(path)
     ext = p.suffix.lower()
     if ext in (".uff", ".unv"):
         return guarded(read_frf_uff, p)
@@ -285,9 +280,7 @@ def read_spectrum(path: str | os.PathLike):
     >>> spec = vm.read_spectrum("fft_export.lvm")  # doctest: +SKIP
     """
     from .lvm import read_lvm_spectrum
-    p = Path(path)
-    if not p.exists():
-        raise ParameterError(f"path={str(path)!r} does not exist")
+    p = regular_input(path)
     if p.suffix.lower() != ".lvm":
         raise ParameterError(f"path={str(path)!r}: spectra are read from LabVIEW .lvm exports, not {p.suffix!r}")
     return guarded(read_lvm_spectrum, p)

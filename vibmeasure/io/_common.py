@@ -121,10 +121,12 @@ def _fsync_dir(folder: Path):
 
 
 def file_sha256(path) -> str:
-    """SHA-256 of a file's bytes, read in 4 MiB blocks."""
+    """SHA-256 of a file's bytes, read in 4 MiB blocks (a regular file only: a FIFO or device never ends)."""
     import hashlib
+
+    from ..core._validate import regular_input
     h = hashlib.sha256()
-    with open(path, "rb") as fh:
+    with open(regular_input(path), "rb") as fh:
         for block in iter(lambda: fh.read(1 << 22), b""):
             h.update(block)
     return h.hexdigest()

@@ -97,6 +97,30 @@ def _str_list(a) -> list[str]:
     return [x.decode() if isinstance(x, bytes) else str(x) for x in np.atleast_1d(a)]
 
 
+def refuse_foreign(f, src: str) -> None:
+    """Every object of the file lives in it: an external link, external raw storage or a virtual dataset
+    (each reads or writes another file) anywhere in the tree is refused, before anything is read."""
+    import h5py
+    stack = [f]
+    while stack:
+        g = stack.pop()
+        for name in g:
+            lk = g.get(name, getlink=True)
+            where = f"{g.name.rstrip('/')}/{name}"
+            if isinstance(lk, h5py.ExternalLink):
+                raise ParameterError(f"{src}: {where!r} is an external link to {lk.filename!r}; a store reads and "
+                                     "writes only its own file: refused")
+            if isinstance(lk, h5py.SoftLink):
+                continue          # a path inside this file; its target is walked where it stands
+            obj = g.get(name)
+            if isinstance(obj, h5py.Group):
+                stack.append(obj)
+            elif isinstance(obj, h5py.Dataset) and (obj.external or obj.is_virtual):
+                raise ParameterError(f"{src}: {where!r} keeps its samples in other files "
+                                     f"({'virtual dataset' if obj.is_virtual else 'external raw storage'}); "
+                                     "refused")
+
+
 def _dataset(f, name: str, src: str, *, allow_external: bool, max_samples: int):
     """A dataset of the file, checked before anything is read: it must live in this file (no external
     link, external raw storage or virtual mapping unless allowed), be numeric and within max_samples."""
@@ -130,6 +154,39 @@ def _dataset(f, name: str, src: str, *, allow_external: bool, max_samples: int):
     return d
 
 
+def schema_header(f, src: str, *, allow_external: bool, max_samples: int):
+    """The checked parts of a record file in vibmeasure's schema, nothing read from the data yet:
+    (dataset, channels, fs, t0, meta, history). The eager and the lazy reader share every check."""
+    ver = f.attrs.get("schema_version", -1)
+    try:
+        ver = int(ver)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{src}: schema_version {ver!r} is not a whole number") from None
+    if ver > SCHEMA_VERSION:
+        raise ParameterError(f"{src} has schema_version {ver}; this vibmeasure reads up to {SCHEMA_VERSION}")
+    d = _dataset(f, "data", src, allow_external=allow_external, max_samples=max_samples)
+    a = d.attrs
+    try:
+        chans = tuple(Channel(n, q, u, loc) for n, q, u, loc in zip(
+            _str_list(a["channel_names"]), _str_list(a["channel_quantities"]),
+            _str_list(a["channel_units"]), _str_list(a["channel_locations"])))
+        rfs = parse_number(a["fs"], source=src, key="attribute fs")
+        t0 = parse_number(a["t0"], source=src, key="attribute t0")
+        meta = json.loads(f.attrs.get("meta", "{}"))
+        history = tuple(json.loads(f.attrs.get("history", "[]")))
+    except (KeyError, OSError, ValueError, TypeError) as exc:
+        raise ParameterError(f"{src} claims schema {SCHEMA} but is damaged: {type(exc).__name__} {exc}") from None
+    if not isinstance(meta, dict):
+        raise ParameterError(f"{src}: its meta attribute is JSON but not a mapping")
+    if rfs <= 0:
+        raise ParameterError(f"{src}: attribute fs = {rfs:g} must be > 0")
+    if d.ndim != 2 or d.shape[0] != len(chans) or len(chans) == 0:
+        raise ParameterError(f"{src}: data has shape {d.shape} but {len(chans)} channel descriptions")
+    if d.shape[1] < 2:
+        raise ParameterError(f"{src}: data holds {d.shape[1]} samples per channel; a record needs at least 2")
+    return d, chans, rfs, t0, meta, history
+
+
 def read_hdf5(path, *, fs=None, channels=None, quantity=None, unit=None, dataset=None, allow_external=False,
               max_samples=DEFAULT_MAX_SAMPLES) -> Record:
     src = f"HDF5 file {str(path)!r}"
@@ -137,24 +194,12 @@ def read_hdf5(path, *, fs=None, channels=None, quantity=None, unit=None, dataset
         schema = f.attrs.get("vibmeasure_schema")
         schema = schema.decode() if isinstance(schema, bytes) else schema
         if schema == SCHEMA and dataset is None:
-            ver = int(f.attrs.get("schema_version", -1))
-            if ver > SCHEMA_VERSION:
-                raise ParameterError(f"{src} has schema_version {ver}; this vibmeasure reads up to {SCHEMA_VERSION}")
-            d = _dataset(f, "data", src, allow_external=allow_external, max_samples=max_samples)
+            d, chans, rfs, t0, meta, history = schema_header(f, src, allow_external=allow_external,
+                                                            max_samples=max_samples)
             try:
                 data = real_samples(d[()], source=src)
-                a = d.attrs
-                chans = [Channel(n, q, u, loc) for n, q, u, loc in zip(
-                    _str_list(a["channel_names"]), _str_list(a["channel_quantities"]),
-                    _str_list(a["channel_units"]), _str_list(a["channel_locations"]))]
-                rfs = parse_number(a["fs"], source=src, key="attribute fs")
-                t0 = parse_number(a["t0"], source=src, key="attribute t0")
-                meta = json.loads(f.attrs.get("meta", "{}"))
-                history = tuple(json.loads(f.attrs.get("history", "[]")))
-            except (KeyError, OSError, ValueError, TypeError) as exc:
-                raise ParameterError(f"{src} claims schema {SCHEMA} but is damaged: {exc}") from None
-            if len({len(chans), data.shape[0] if data.ndim == 2 else -1}) != 1:
-                raise ParameterError(f"{src}: data has shape {data.shape} but {len(chans)} channel descriptions")
+            except (OSError, ValueError, TypeError) as exc:
+                raise ParameterError(f"{src} claims schema {SCHEMA} but its data are unreadable: {exc}") from None
             if fs is not None and float(fs) != rfs:
                 raise ParameterError(f"fs={fs} contradicts {src}, which stores fs={rfs}")
             rec = Record(data, rfs, tuple(chans), t0=t0, meta=meta, history=history)

@@ -12,9 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core._validate import regular_input
 from ..core.errors import ParameterError
 from ..core.record import Channel, Record
-from ._common import require_fs
+from ._common import parse_number, require_fs
 
 __all__ = ["LazyRecord", "open_record"]
 
@@ -258,11 +259,9 @@ def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: floa
     >>> vm.open(path).n_samples
     1000
     """
-    import json
-    from .hdf5 import SCHEMA, _str_list
-    p = Path(path)
-    if not p.exists():
-        raise ParameterError(f"path={str(path)!r} does not exist")
+    from .hdf5 import SCHEMA, schema_header
+    p = regular_input(path)
+    src = f"HDF5 file {str(path)!r}"
     if p.suffix.lower() not in (".h5", ".hdf5"):
         raise ParameterError(f"path={str(path)!r}: vm.open reads HDF5 (.h5, .hdf5); use vm.read for {p.suffix!r}")
     import h5py
@@ -276,16 +275,13 @@ def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: floa
         schema = f.attrs.get("vibmeasure_schema")
         schema = schema.decode() if isinstance(schema, bytes) else schema
         if dataset is None and schema == SCHEMA:
-            d = f["data"]
+            d, chans, rfs, t0, meta, _ = schema_header(f, src, allow_external=False, max_samples=2 ** 62)
             _check_stored(d, p)
-            a = d.attrs
-            chans = tuple(Channel(n, q, u, loc) for n, q, u, loc in zip(
-                _str_list(a["channel_names"]), _str_list(a["channel_quantities"]),
-                _str_list(a["channel_units"]), _str_list(a["channel_locations"])))
-            rfs, t0 = float(a["fs"]), float(a["t0"])
+            if d.dtype.kind not in "fiu":
+                raise ParameterError(f"{src}: data are {d.dtype}; a record streamed by vm.open holds real numbers "
+                                     "(vm.read takes complex data whose imaginary part is zero)")
             if fs is not None and float(fs) != rfs:
                 raise ParameterError(f"fs={fs} contradicts {str(path)!r}, which stores fs={rfs}")
-            meta = json.loads(f.attrs.get("meta", "{}"))
             return LazyRecord(p, "data", rfs, chans, t0=t0, meta=meta)
         if dataset is None:
             raise ParameterError(f"{str(path)!r} is not a vibmeasure record file: name the dataset (dataset=...)")
@@ -297,7 +293,11 @@ def open_record(path: str | os.PathLike, *, dataset: str | None = None, fs: floa
         if d.ndim not in (1, 2) or d.dtype.kind not in "fiu":
             raise ParameterError(f"dataset={dataset!r} must be 1-D or (n_channels, n_samples) numbers, "
                                  f"got shape {d.shape} dtype {d.dtype}")
-        attr_fs = next((float(d.attrs[k]) for k in ("fs", "sampling_rate", "fs_hz") if k in d.attrs), None)
+        if (d.shape[-1] if d.ndim else 0) < 2:
+            raise ParameterError(f"dataset={dataset!r} holds {d.shape[-1] if d.ndim else 0} samples; a record needs "
+                                 "at least 2")
+        attrs = [k for k in ("fs", "sampling_rate", "fs_hz") if k in d.attrs]
+        attr_fs = parse_number(d.attrs[attrs[0]], source=src, key=f"attribute {attrs[0]}") if attrs else None
         fs = attr_fs if fs is None and attr_fs is not None else require_fs(fs, source=f"{str(path)!r}:{dataset}")
         n_ch = 1 if d.ndim == 1 else d.shape[0]
     from ..core import units as _units

@@ -26,6 +26,38 @@ _RPM_LEAF = re.compile(r".*rpm$", re.I)
 _SHAFT_HZ_LEAF = re.compile(r"^(shaft_?rate|shaft_?hz|shaft_?speed_?hz|shaft_?frequency)$", re.I)
 
 
+def _declared_bytes_v5(path) -> int:
+    """Bytes the variables of a MAT v5 file take once decompressed, from each element's tag: a compressed
+    element's first 8 decompressed bytes are its matrix tag, whose size counts every nested struct field
+    and cell. Read before anything is decompressed, so a small file that inflates to gigabytes is
+    refused by its declared size."""
+    import struct
+    import zlib
+    total = 0
+    with open(path, "rb") as fh:
+        head = fh.read(128)
+        if len(head) < 128:
+            return 0
+        end = "<" if head[126:128] == b"IM" else ">"
+        while True:
+            tag = fh.read(8)
+            if len(tag) < 8:
+                return total
+            kind, nbytes = struct.unpack(end + "II", tag)
+            if kind == 15:          # miCOMPRESSED: its first 8 inflated bytes are the matrix tag
+                first = fh.read(min(nbytes, 256))
+                try:
+                    inner = zlib.decompressobj().decompress(first, 8)
+                except zlib.error:
+                    return total      # damaged: loadmat names it
+                if len(inner) == 8:
+                    total += struct.unpack(end + "II", inner)[1]
+                fh.seek(nbytes - len(first), 1)
+            else:
+                total += nbytes
+                fh.seek(nbytes + (-nbytes) % 8, 1)
+
+
 def _leaves_v5(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
     import scipy.io as sio
     try:
@@ -33,9 +65,14 @@ def _leaves_v5(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
             for name, shape, _cls in sio.whosmat(path):
                 check_size(int(np.prod(shape, dtype=np.float64)), source=f"MAT file {str(path)!r}",
                            max_samples=max_samples, what=f"variable {name!r}")
+            # nested struct fields and cells are not in whosmat: their inflated bytes, at 8 a sample
+            check_size(_declared_bytes_v5(path) // 8, source=f"MAT file {str(path)!r}", max_samples=max_samples,
+                       what="its content, decompressed,")
         raw = sio.loadmat(path, squeeze_me=False, struct_as_record=True)
     except NotImplementedError:
         raise _V73() from None
+    except ParameterError:
+        raise
     except Exception as exc:  # scipy raises ValueError, TypeError, OSError... for damaged files
         raise ParameterError(f"MAT file {str(path)!r} is unreadable (truncated or not MATLAB): {exc}") from None
     out: dict[str, np.ndarray] = {}

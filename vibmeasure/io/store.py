@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core._validate import regular_input
 from ..core.errors import ParameterError
 from ._store_common import STORE_SCHEMA, STORE_VERSION, TABLES, StoreLockedError, _hash_key
 from .store_query import _Queries
@@ -94,7 +95,11 @@ class Store(_Queries, _Writes):
         if raw_dir is not None:
             raise ParameterError("raw_dir= is for a database store (.db or a URL): an HDF5 store keeps its raw "
                                  "records inside its file")
-        self.path = Path(path)
+        # a symlink is followed first: the lock and every commit act on the real file, so two writers
+        # reaching it by different names still exclude each other and the link stays a link
+        self.path = Path(os.path.realpath(path))
+        if self.path.exists():
+            regular_input(self.path, "store")
         self.writable = bool(writable)
         self._lock_fd = None
         # in memory: assets and points (the fleet's size), the committed row counts, a compact index of
@@ -214,7 +219,7 @@ class Store(_Queries, _Writes):
             raise ParameterError(f"store {str(self.path)!r} is damaged: {exc}") from None
 
     def _load(self) -> None:
-        from .hdf5 import check_seal
+        from .hdf5 import check_seal, refuse_foreign
         src = f"store {str(self.path)!r}"
         if not self.path.is_file():
             raise ParameterError(f"{src} is not a file")
@@ -226,6 +231,7 @@ class Store(_Queries, _Writes):
                 schema = schema.decode() if isinstance(schema, bytes) else schema
                 if schema != STORE_SCHEMA:
                     raise ParameterError(f"{src} is not a vibmeasure store (schema {schema!r})")
+                refuse_foreign(f, src)
                 version = int(f.attrs.get("schema_version", -1))
                 if version != STORE_VERSION:
                     raise ParameterError(f"{src} has store schema version {version}; this vibmeasure reads version "

@@ -4,10 +4,10 @@ which `vibmeasure model --help` prints)."""
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import numpy as np
 
+from ..core._validate import regular_input
 from ..core.errors import ParameterError
 
 # unit -> (dimension, factor to SI)
@@ -133,10 +133,8 @@ def load(path) -> object:
     from .continua import Beam, Rod, Shaft, String
     from .mdof import MDOF
     from .sdof import SDOF
-    p = Path(path)
     src = f"model file {str(path)!r}"
-    if not p.exists():
-        raise ParameterError(f"path={str(path)!r} does not exist")
+    p = regular_input(path, "path")
     if p.stat().st_size > MAX_BYTES:
         raise ParameterError(f"{src} is {p.stat().st_size:,} bytes: larger than any model this loader takes "
                              f"(at most {MAX_DOF} degrees of freedom)")

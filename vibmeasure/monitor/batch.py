@@ -15,8 +15,6 @@ names is analysed once, with the manifest's metadata, even when it is also given
 
 from __future__ import annotations
 
-import csv
-import glob
 import os
 import time as _time
 from pathlib import Path
@@ -27,13 +25,11 @@ from ..core._threads import one_blas_thread
 from ..core.dispatch import analysis_for
 from ..core.errors import ParameterError, VibMeasureError
 from ..io._common import file_sha256
+from .inputs import _expand, _unique, read_manifest
 
-__all__ = ["batch", "read_manifest", "analyse_file", "TASKS", "MANIFEST_COLUMNS"]
+__all__ = ["batch", "analyse_file", "TASKS"]
 
 TASKS = ("ringdown", "modes", "spectrum", "diagnose", "compare")
-MANIFEST_COLUMNS = ("file", "asset", "point", "channel", "rpm", "bearing", "model", "time", "tach", "pulses_per_rev",
-                    "unit", "fs")
-READABLE = (".csv", ".txt", ".h5", ".hdf5", ".wav", ".mat", ".lvm", ".uff", ".unv")
 COMMIT_EVERY = 50       # inputs per commit (each commit rewrites the store: see io/store.py)
 MAX_PER_TASK = 8        # inputs per Dask task at most (fewer when the batch is small: every worker keeps busy)
 COMMIT_SECONDS = 10.0
@@ -54,143 +50,6 @@ def _tasks(task) -> tuple[str, ...]:
     if not out:
         raise ParameterError(f"task must name at least one of {TASKS}")
     return tuple(out)
-
-
-def read_manifest(path) -> list[dict]:
-    """Rows of a manifest CSV, each with its ``file`` glob expanded (relative to the manifest).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The manifest: columns file, asset, point, channel, rpm, bearing, model, time, tach,
-        pulses_per_rev, unit, fs (any other column is an error).
-
-    Returns
-    -------
-    list of dict
-        One item per file.
-
-    Raises
-    ------
-    ParameterError
-        For a missing manifest, an unknown column or a glob that matches nothing.
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> import vibmeasure as vm
-    >>> folder = pathlib.Path(tempfile.mkdtemp())
-    >>> items = vm.synth.fleet(folder, n_measurements=2)
-    >>> len(vm.read_manifest(folder / "machines.csv")) > 0
-    True
-    """
-    p = Path(path)
-    if not p.is_file():
-        raise ParameterError(f"manifest={str(path)!r} does not exist")
-    with open(p, newline="", encoding="utf-8-sig") as fh:
-        reader = csv.DictReader(fh)
-        cols = [c.strip() for c in (reader.fieldnames or [])]
-        unknown = [c for c in cols if c not in MANIFEST_COLUMNS]
-        if unknown:
-            raise ParameterError(f"manifest {str(path)!r}: unknown column(s) {unknown}; the columns are "
-                                 f"{list(MANIFEST_COLUMNS)}")
-        if "file" not in cols:
-            raise ParameterError(f"manifest {str(path)!r} needs a 'file' column")
-        rows = []
-        for i, raw in enumerate(reader, start=2):
-            row = {k.strip(): (v.strip() if isinstance(v, str) else v) for k, v in raw.items() if k}
-            if not row.get("file"):
-                raise ParameterError(f"manifest {str(path)!r} line {i}: empty 'file'")
-            pattern = row["file"] if os.path.isabs(row["file"]) else str(p.parent / row["file"])
-            hits = sorted(glob.glob(pattern)) if any(c in pattern for c in "*?[") else [pattern]
-            if not hits:
-                raise ParameterError(f"manifest {str(path)!r} line {i}: no file matches {row['file']!r}")
-            if row.get("rpm"):
-                try:
-                    row["rpm"] = float(row["rpm"])
-                except ValueError:
-                    raise ParameterError(f"manifest {str(path)!r} line {i}: rpm={row['rpm']!r} is not a number") from None
-            if row.get("fs"):
-                try:
-                    row["fs"] = float(row["fs"])
-                except ValueError:
-                    raise ParameterError(f"manifest {str(path)!r} line {i}: fs={row['fs']!r} is not a number") from None
-            if row.get("pulses_per_rev"):
-                try:
-                    row["pulses_per_rev"] = int(row["pulses_per_rev"])
-                except ValueError:
-                    raise ParameterError(f"manifest {str(path)!r} line {i}: pulses_per_rev={row['pulses_per_rev']!r} "
-                                         "is not a whole number") from None
-            if row.get("model") and not os.path.isabs(row["model"]):
-                row["model"] = str(p.parent / row["model"])
-            for h in hits:
-                rows.append({k: (v if v != "" else None) for k, v in dict(row, file=h).items()})
-    return rows
-
-
-def _expand(inputs) -> list[dict]:
-    if isinstance(inputs, (str, os.PathLike)):
-        inputs = [inputs]
-    items = []
-    for x in inputs:
-        s = str(x)
-        if any(c in s for c in "*?["):
-            hits = sorted(glob.glob(s, recursive=True))
-            if not hits:
-                raise ParameterError(f"input {s!r} matches no file")
-        elif os.path.isdir(s):
-            hits = sorted(str(q) for q in Path(s).rglob("*") if _data_name(q) and q.is_file())
-        elif os.path.isfile(s):
-            items.append({"file": s})   # a file named by the user is read whatever its name
-            continue
-        else:
-            raise ParameterError(f"input {s!r} is not a file, folder or glob")
-        items += [{"file": h} for h in hits if _data_name(Path(h))]
-    return items
-
-
-def _data_name(p: Path) -> bool:
-    """Whether a file found in a folder or by a glob is a record to read: a readable suffix, or none
-    at all, or a numeric one (rigs that name files by their time stamp, "2004.02.12.10.32.39");
-    never a hidden file (a store's lock, a writer's temporary file)."""
-    suffix = p.suffix.lower()
-    return not p.name.startswith(".") and (suffix in READABLE or suffix == "" or suffix[1:].isdigit())
-
-
-def _is_manifest(path) -> bool:
-    """Whether a CSV file is a manifest (its header: a ``file`` column and manifest columns only), not
-    a record: a folder of records often holds its manifest too."""
-    if Path(path).suffix.lower() != ".csv":
-        return False
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            head = next(csv.reader(fh), [])
-    except (OSError, UnicodeDecodeError, csv.Error):
-        return False
-    cols = [c.strip() for c in head]
-    return "file" in cols and all(c in MANIFEST_COLUMNS for c in cols)
-
-
-def _unique(inputs: list, rows: list, manifest=None) -> tuple[list, list]:
-    """(items, notes): each file once; a file a manifest row names takes that row's metadata (the
-    plain input is dropped), a manifest is no record; a row listed twice is analysed once. Notes:
-    (file, message) per drop."""
-    named = {os.path.realpath(r["file"]) for r in rows}
-    if manifest is not None:
-        named.add(os.path.realpath(manifest))
-    items, notes, seen = [], [], set()
-    for it in inputs:
-        if os.path.realpath(it["file"]) not in named and _is_manifest(it["file"]):
-            notes.append((it["file"], "a manifest, not a record: give it as manifest= (--manifest)"))
-            named.add(os.path.realpath(it["file"]))
-    for it in [i for i in inputs if os.path.realpath(i["file"]) not in named] + rows:
-        key = (os.path.realpath(it["file"]), tuple(sorted((k, str(v)) for k, v in it.items() if k != "file")))
-        if key in seen:
-            notes.append((it["file"], "listed twice: analysed once"))
-            continue
-        seen.add(key)
-        items.append(it)
-    return items, notes
 
 
 # --- the work of one input (runs on a worker) ------------------------------------------------------
@@ -448,12 +307,15 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
     tasks = _tasks(task)
     items, notes = _unique(_expand(inputs) if inputs else [], read_manifest(manifest) if manifest is not None else [],
                            manifest)
-    if not items:
+    bad = [it for it in items if "error" in it]
+    items = [it for it in items if "error" not in it]
+    if not items and not bad:
         raise ParameterError("no input: give files, folders or globs, or a manifest")
     options = {"fs": fs, "band": band}
     own = not is_store(store)
     st = Store(store, writable=True) if own else store
-    rows, todo = [(f, "skipped", None, m) for f, m in notes], []
+    rows = [(f, "skipped", None, m) for f, m in notes] + [(it["file"], "error", None, it["error"]) for it in bad]
+    todo = []
     try:
         stored = _Stored(st, tasks) if st.n_measurements else None
         for it in items:
@@ -462,7 +324,7 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
                 continue
             try:
                 sha = file_sha256(it["file"])
-            except OSError as exc:
+            except (OSError, VibMeasureError) as exc:
                 rows.append((it["file"], "error", None, str(exc)))
                 continue
             mid, missing = stored.find(sha, it)

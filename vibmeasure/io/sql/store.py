@@ -19,6 +19,7 @@ import hashlib
 import time as _time
 from pathlib import Path
 
+from ...core._validate import regular_input
 from ...core.errors import ParameterError
 from .._store_common import STORE_SCHEMA, STORE_VERSION, StoreLockedError, _asset_row, _check_name, _seconds
 from . import schema as _schema_mod
@@ -91,6 +92,8 @@ class SQLStore(_SQLQueries):
         self._seen_points: set = set()
         self._seen_ids: set = set()
         self._results_out: list = []
+        if self.is_sqlite and self.path.exists():
+            regular_input(self.path, "store")
         if self.is_sqlite and not self.writable and not self.path.exists():
             raise ParameterError(f"store {self.target!r} does not exist (open it with writable=True to create it)")
         self._engine = self._make_engine(sa)
