@@ -559,3 +559,28 @@ def test_a_bad_manifest_row_is_its_own_error_and_the_batch_goes_on(tmp_path):
     m.write_bytes(b"file,asset\n\xff\xfe.h5,a\n")
     with pytest.raises(vm.ParameterError, match="not UTF-8"):
         vm.read_manifest(m)
+
+
+@pytest.mark.parametrize("address", ["tcp://", "tcp://host:notaport", "foo"])
+def test_a_malformed_scheduler_address_is_named(tmp_path, address):
+    vm.synth.fleet(tmp_path, n_measurements=2)
+    with pytest.raises(vm.ParameterError, match="not a scheduler address"):
+        vm.batch(manifest=tmp_path / "machines.csv", store=tmp_path / "s.db", scheduler=address)
+
+
+@pytest.mark.parametrize("table,row", [("results", '{"measurement": "m0000001", "task": "diagnose"}'),
+                                       ("measurements", '["m0000001"]'),
+                                       ("results", '{"measurement": 7, "task": "diagnose", "summary": {}, '
+                                                   '"params": {}}')])
+def test_a_resealed_store_with_rows_of_the_wrong_shape_is_named(tmp_path, table, row):
+    """Issue 48: trend and the queries of a store whose rows were rewritten (and the seal renewed) end in a
+    ParameterError naming the table and the misfit, not a raw KeyError or TypeError."""
+    from vibmeasure.io.hdf5 import seal
+    p = tmp_path / "plant.h5"
+    _one_row_store(p)
+    with h5py.File(p, "a") as f:
+        f[table][0] = row
+    seal(p)
+    with pytest.raises(vm.ParameterError, match=f"damaged: a row of {table}"):
+        st = vm.Store(p)
+        vm.trend(st)

@@ -494,3 +494,51 @@ def test_a_mat_file_that_inflates_past_the_limit_is_refused_before_it_is_decompr
     assert p.stat().st_size < 200_000
     with pytest.raises(vm.ParameterError, match="decompressed, declares 20,000,0"):
         vm.read(p, max_samples=1_000_000)
+
+
+def _wav_bytes(bits, n_data, channels=1, rate=1000):
+    import struct
+    align = channels * max(bits, 8) // 8
+    fmt = struct.pack("<HHIIHH", 1, channels, rate, rate * align, align, bits)
+    body = b"WAVE" + b"fmt " + struct.pack("<I", 16) + fmt + b"data" + struct.pack("<I", n_data) + b"\0" * n_data
+    return b"RIFF" + struct.pack("<I", len(body)) + body
+
+
+@pytest.mark.parametrize("bits,n_data,rule", [(0, 200, "0 bits per sample"), (12, 200, "12 bits per sample"),
+                                              (16, 0, "0 sample"), (16, 2, "1 sample")])
+def test_crafted_wav_headers_are_named(tmp_path, bits, n_data, rule):
+    """Issue 48: a WAV with 0 bits per sample or an empty data chunk was read as a record."""
+    p = tmp_path / "x.wav"
+    p.write_bytes(_wav_bytes(bits, n_data))
+    with pytest.raises(vm.ParameterError, match=rule):
+        vm.read(p)
+
+
+def test_a_mat_sampling_rate_that_is_a_logical_is_refused(tmp_path):
+    import scipy.io as sio
+    p = tmp_path / "x.mat"
+    sio.savemat(p, {"x": np.random.default_rng(0).normal(size=(1, 1000)), "fs": np.array([[True]])})
+    with pytest.raises(vm.ParameterError, match="fs = True is a boolean"):
+        vm.read(p)
+
+
+def _frf_case(tmp_path, **variables):
+    import scipy.io as sio
+    p = tmp_path / "frf.mat"
+    sio.savemat(p, variables)
+    return p
+
+
+def test_read_frf_of_a_mat_checks_what_an_frf_is(tmp_path):
+    """Issue 48: a real FRF, a frequency with NaN, and a 2-D FRF (read as outputs, not flattened)."""
+    f = np.linspace(1, 100, 100)
+    H = 1 / (1000 - (2 * np.pi * f) ** 2 + 2j * np.pi * f * 2)
+    two = vm.read_frf(_frf_case(tmp_path, H=np.vstack([H, 2 * H]).T, freq=f), variable="H")
+    assert two.h.shape == (2, 1, 100)
+    np.testing.assert_allclose(two.h[1, 0], 2 * H)           # the second output, not the first's tail
+    with pytest.raises(vm.ParameterError, match="is real"):
+        vm.read_frf(_frf_case(tmp_path, H=np.abs(H), freq=f), variable="H")
+    with pytest.raises(vm.ParameterError, match="finite and increasing"):
+        vm.read_frf(_frf_case(tmp_path, H=H, freq=np.r_[f[:-1], np.nan]), variable="H")
+    with pytest.raises(vm.ParameterError, match="finite and increasing"):
+        vm.read_frf(_frf_case(tmp_path, H=H, freq=f[::-1]), variable="H")

@@ -190,3 +190,16 @@ def test_the_kurtogram_marks_where_the_measured_band_ends():
         if edged:
             assert 6400.0 < top < 8000.0 and dashed[0].get_xdata()[0] == pytest.approx(top)
     plt.close("all")
+
+
+@pytest.mark.parametrize("name", [r"$\foo$", "$" + "{" * 400 + "x" + "}" * 400 + "$"])
+def test_names_are_text_not_math(tmp_path, name):
+    """Issue 48: a channel name with math markup is printed as written; mathtext would refuse the first
+    and recurse past Python's limit on the second."""
+    import matplotlib.pyplot as plt
+    rec = vm.Record(np.sin(np.arange(4096) / 7.0)[None], 1000.0, channels=[vm.Channel(name, "acceleration", "m/s^2")])
+    ax = vm.plot.plot_spectrum(vm.amplitude_spectrum(rec))
+    ax.figure.savefig(tmp_path / "s.png")
+    texts = [t.get_text() for t in ax.figure.findobj(lambda o: hasattr(o, "get_text"))]
+    assert any(name in t for t in texts)
+    plt.close(ax.figure)

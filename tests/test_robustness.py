@@ -595,3 +595,52 @@ def test_ringdown_reports_its_progress_in_stages():
     seen = []
     vm.ringdown(rec, progress=seen.append)
     assert seen[0] > 0 and seen[-1] == 1.0 and seen == sorted(seen)
+
+
+@pytest.mark.parametrize("script", ["fsz.py", "fsz_sql.py"])
+def test_a_full_disk_during_a_commit_is_a_named_error_and_the_store_stays(tmp_path, script):
+    """Issue 48: a commit past the file-size limit (ulimit -f, as a full disk) ends in a ParameterError;
+    the process lives (no SIGXFSZ, no crash of HDF5 mid-write) and the store keeps its last commit."""
+    code = {
+        "fsz.py": """
+import os, resource, sys, numpy as np, vibmeasure as vm
+path = sys.argv[1]
+with vm.Store(path, writable=True) as st:
+    st.add_asset("a"); st.add_point("a", "DE"); st.commit()
+    resource.setrlimit(resource.RLIMIT_FSIZE, (os.path.getsize(path) + 200_000, resource.RLIM_INFINITY))
+    rec = vm.Record(np.random.default_rng(0).normal(size=(1, 2_000_000)), 1000.0)
+    st.add_measurement("a", "DE", time="2026-01-01T00:00", rpm=1000, record=rec, keep_raw=True)
+    try:
+        st.commit()
+    except vm.ParameterError as e:
+        print("NAMED:", e)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (resource.RLIM_INFINITY,) * 2)
+    st._pending = {k: [] for k in st._pending}; st._raw_pending = {}
+print("ROWS:", vm.Store(path).n_measurements, len(vm.Store(path).points()))
+""",
+        "fsz_sql.py": """
+import os, resource, sys, vibmeasure as vm
+path = sys.argv[1]
+st = vm.Store(path, writable=True)
+st.add_asset("a"); st.add_point("a", "DE"); st.commit()
+size = sum(os.path.getsize(p) for p in (path, path + "-wal") if os.path.exists(p))
+resource.setrlimit(resource.RLIMIT_FSIZE, (size + 100_000, resource.RLIM_INFINITY))
+try:
+    for i in range(3000):
+        mid = st.add_measurement("a", "DE", time=f"2026-01-01T00:{i // 60 % 60:02d}:{i % 60:02d}", rpm=1000 + i)
+        st.add_result(mid, "diagnose", {"top": "none", "pad": "x" * 500}, summary={"top": "none"})
+    st.commit()
+except vm.ParameterError as e:
+    print("NAMED:", e)
+resource.setrlimit(resource.RLIMIT_FSIZE, (resource.RLIM_INFINITY,) * 2)
+try:
+    st.close(commit=False)
+except vm.VibMeasureError:
+    pass
+print("ROWS:", vm.Store(path).n_measurements, len(vm.Store(path).points()))
+"""}[script]
+    target = tmp_path / ("s.h5" if script == "fsz.py" else "s.db")
+    run = subprocess.run([sys.executable, "-c", code, str(target)], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert "NAMED:" in run.stdout
+    assert "ROWS: 0 1" in run.stdout          # the last commit (one asset, one point) and nothing else

@@ -35,7 +35,8 @@ STYLE: dict = {
     "lines.linewidth": 1.0,
     "lines.markersize": 4.0,
     "image.cmap": "viridis",
-    "axes.formatter.use_mathtext": True,
+    "text.parse_math": False,                 # names are text: a channel called "$x$" is printed, not typeset
+    "axes.formatter.use_mathtext": False,
     "axes.formatter.limits": (-4, 5),        # scientific notation only for very large or small numbers
 }
 

@@ -26,6 +26,15 @@ def build_parser() -> Parser:
     return p
 
 
+def _writes_fail_not_kill() -> None:
+    """A file-size limit (ulimit -f) makes a write fail with an error the command names, not SIGXFSZ,
+    whose default kills the process mid-file."""
+    import signal
+    import threading
+    if hasattr(signal, "SIGXFSZ") and threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+
+
 def main(argv=None, *, out=None, err=None) -> int:
     """Run the command line and return its exit code.
 
@@ -49,6 +58,7 @@ def main(argv=None, *, out=None, err=None) -> int:
     """
     out = out or sys.stdout
     err = err or sys.stderr
+    _writes_fail_not_kill()
     args = build_parser().parse_args(argv)
     try:
         return COMMANDS[args.command].run(args, out, err)

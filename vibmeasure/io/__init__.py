@@ -228,29 +228,13 @@ def read_frf(path: str | os.PathLike, *, variable: str | None = None, fs: float 
     >>> import vibmeasure as vm
     >>> frf = vm.read_frf("../shared/data/impact/case1.mat", variable="Hf_chan_2")  # doctest: +SKIP
     """
-    from ..core.results import FRF
     p = regular_input(path)
     ext = p.suffix.lower()
     if ext in (".uff", ".unv"):
         return guarded(read_frf_uff, p)
     if ext == ".mat":
-        import numpy as np
-        from .mat import _leaves_v5
-        leaves = _leaves_v5(p)
-        if variable is None:
-            cands = [k for k, v in leaves.items() if np.iscomplexobj(v) and v.size > 8]
-            if len(cands) != 1:
-                raise ParameterError(f"variable= is required: complex variables in {str(path)!r}: {cands}")
-            variable = cands[0]
-        if variable not in leaves:
-            raise ParameterError(f"variable={variable!r} is not in {str(path)!r}")
-        h = np.asarray(leaves[variable]).ravel()
-        fvec = next((np.asarray(v, float).ravel() for k, v in leaves.items()
-                     if "freq" in k.lower() and np.size(v) == h.size), None)
-        if fvec is None:
-            raise ParameterError(f"no frequency vector of {h.size} lines in {str(path)!r}")
-        return FRF(fvec, h, "unknown", estimator="file", outputs=(variable,), inputs=("force",),
-                   params={"source": str(p)})
+        from .mat import read_frf_mat
+        return read_frf_mat(p, variable)
     raise ParameterError(f"path={str(path)!r}: FRFs are read from .uff/.unv or .mat, not {ext!r}")
 
 

@@ -133,6 +133,22 @@ def file_sha256(path) -> str:
 
 
 @contextlib.contextmanager
+def write_errors_not_signals():
+    """While writing, a file-size limit makes write() fail with EFBIG (an OSError the caller names) instead
+    of the default SIGXFSZ, which kills the process. Only the main thread may change a signal's handler."""
+    import signal
+    import threading
+    if not hasattr(signal, "SIGXFSZ") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGXFSZ, old)
+
+
+@contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
     """Yield a temporary path beside ``path``; it replaces ``path`` only if the block succeeds.
 
@@ -244,6 +260,9 @@ def make_record(data, fs, names, *, quantity=None, unit=None, quantities=None, u
     data = np.asarray(data, dtype=np.float64)
     if data.ndim == 1:
         data = data[np.newaxis]
+    if data.ndim != 2 or data.shape[1] < 2:
+        raise ParameterError(f"{source}: holds {data.shape[-1] if data.ndim else 0} sample(s) per channel; a record "
+                             "needs at least 2 (an empty or cut data block)")
     bad = ~np.isfinite(data)
     if bad.any():
         ch, i = np.unravel_index(int(np.argmax(bad)), data.shape)

@@ -9,6 +9,26 @@ from ..core.errors import ParameterError, VibMeasureError
 STORE_SCHEMA = "vibmeasure.store"
 STORE_VERSION = 1
 TABLES = ("assets", "points", "measurements", "results")
+# what each stored row must hold: a row of another shape is a damaged (or crafted) store, refused by name
+ROW_SHAPE = {
+    "assets": {"asset": str},
+    "points": {"asset": str, "point": str},
+    "measurements": {"id": str, "asset": str, "point": str, "meta": dict},
+    "results": {"measurement": str, "task": str, "summary": dict, "params": dict},
+}
+
+
+def check_row(table: str, row, src: str) -> dict:
+    """``row`` if it has its table's keys with their types, else a ParameterError naming the first misfit."""
+    if not isinstance(row, dict):
+        raise ParameterError(f"{src} is damaged: a row of {table} is {type(row).__name__}, not a mapping")
+    for key, kind in ROW_SHAPE[table].items():
+        if not isinstance(row.get(key), kind):
+            raise ParameterError(f"{src} is damaged: a row of {table} has {key}={str(row.get(key))[:40]!r}, "
+                                 f"not a {kind.__name__}")
+    return row
+
+
 TASK_ALIASES = {"diagnosis": "diagnose", "modal": "modes", "spectra": "spectrum", "comparison": "compare"}
 
 

@@ -69,6 +69,10 @@ def _leaves_v5(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
             check_size(_declared_bytes_v5(path) // 8, source=f"MAT file {str(path)!r}", max_samples=max_samples,
                        what="its content, decompressed,")
         raw = sio.loadmat(path, squeeze_me=False, struct_as_record=True)
+        # scipy gives a MATLAB logical as uint8; whosmat knows it was true/false, not a number
+        for name, _shape, cls in sio.whosmat(path):
+            if cls == "logical" and name in raw:
+                raw[name] = np.asarray(raw[name]).astype(bool)
     except NotImplementedError:
         raise _V73() from None
     except ParameterError:
@@ -318,3 +322,45 @@ def _stated_speed(scalars: dict, stated_fs: dict, src: str) -> dict:
         return {}
     _, key, rpm = max(found, key=lambda f: f[0])   # an rpm stated as such first
     return {"rpm": rpm, "rpm_source": f"variable {key!r}"}
+
+
+def read_frf_mat(path, variable: str | None = None):
+    """An FRF stored in a MAT file (v5 or v7.3): a complex variable of one or (outputs, lines) rows and a
+    frequency vector of as many lines (a variable whose name holds "freq"), each checked: complex, finite,
+    frequencies increasing."""
+    from ..core.results import FRF
+    src = f"MAT file {str(path)!r}"
+    try:
+        leaves = _leaves_v5(path)
+    except _V73:
+        leaves = _leaves_v73(path)
+    if variable is None:
+        cands = [k for k, v in leaves.items() if np.iscomplexobj(v) and v.size > 8]
+        if len(cands) != 1:
+            raise ParameterError(f"variable= is required: complex variables in {src}: {cands}")
+        variable = cands[0]
+    if variable not in leaves:
+        raise ParameterError(f"variable={variable!r} is not in {src}")
+    h = np.squeeze(np.asarray(leaves[variable]))
+    if not np.iscomplexobj(h):
+        raise ParameterError(f"{src}: variable {variable!r} is real; an FRF is complex (a magnitude alone has no "
+                             "phase to fit modes to): export the complex FRF")
+    if h.ndim not in (1, 2) or h.size < 2:
+        raise ParameterError(f"{src}: variable {variable!r} has shape {h.shape}; an FRF is one row of lines or "
+                             "(outputs, lines)")
+    freqs = {k: np.asarray(v, float).ravel() for k, v in leaves.items()
+             if "freq" in k.lower() and np.asarray(v).dtype.kind in "fiu" and np.size(v) in h.shape}
+    if not freqs:
+        raise ParameterError(f"{src}: no frequency vector (a variable named *freq*) of {h.shape[-1]} lines"
+                             + (f" or {h.shape[0]}" if h.ndim == 2 else ""))
+    name, fvec = next(iter(freqs.items()))
+    if h.ndim == 2 and h.shape[1] != fvec.size:
+        h = h.T                  # stored as (lines, outputs)
+    h = np.atleast_2d(h)
+    if not (np.all(np.isfinite(fvec)) and np.all(np.diff(fvec) > 0)):
+        raise ParameterError(f"{src}: frequency vector {name!r} must be finite and increasing")
+    if not np.all(np.isfinite(h)):
+        raise ParameterError(f"{src}: variable {variable!r} holds NaN or inf values")
+    outputs = (variable,) if h.shape[0] == 1 else tuple(f"{variable}[{i}]" for i in range(h.shape[0]))
+    return FRF(fvec, h[:, None, :], "unknown", estimator="file", outputs=outputs, inputs=("force",),
+               params={"source": str(path)})

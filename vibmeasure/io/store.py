@@ -288,38 +288,31 @@ class Store(_Queries, _Writes):
         import h5py
 
         from .. import __version__
-        from ._common import atomic_path
+        from ._common import atomic_path, write_errors_not_signals
         from .hdf5 import USERBLOCK, seal
-        with atomic_path(self.path) as tmp:
-            if self.path.exists():
-                shutil.copyfile(self.path, tmp)
-                f = h5py.File(tmp, "r+")
-            else:
-                f = h5py.File(tmp, "w", userblock_size=USERBLOCK)
-                f.attrs["vibmeasure_schema"] = STORE_SCHEMA
-                f.attrs["schema_version"] = STORE_VERSION
-                f.attrs["created"] = _time.time()
-                str_t = h5py.string_dtype()
-                for k in TABLES:
-                    f.create_dataset(k, shape=(0,), maxshape=(None,), dtype=str_t, chunks=(256,))
-                f.create_group("raw")
-            with f:
-                f.attrs["written_by"] = f"vibmeasure {__version__}"
-                for k in TABLES:
-                    new = self._pending[k]
-                    if not new:
-                        continue
-                    d = f[k]
-                    n0 = d.shape[0]
-                    d.resize((n0 + len(new),))
-                    d[n0:] = [json.dumps(r, allow_nan=True) for r in new]
-                for mid, rec in self._raw_pending.items():
-                    d = f["raw"].create_dataset(mid, data=np.asarray(rec.data), compression="gzip", compression_opts=1)
-                    d.attrs["fs"] = rec.fs
-                    d.attrs["t0"] = rec.t0
-                    d.attrs["channels"] = json.dumps([{"name": c.name, "quantity": c.quantity, "unit": c.unit,
-                                                       "location": c.location} for c in rec.channels])
-            seal(tmp)
+        self._room_for_commit()
+        try:
+            with write_errors_not_signals():
+                with atomic_path(self.path) as tmp:
+                    if self.path.exists():
+                        shutil.copyfile(self.path, tmp)
+                        f = h5py.File(tmp, "r+")
+                    else:
+                        f = h5py.File(tmp, "w", userblock_size=USERBLOCK)
+                        f.attrs["vibmeasure_schema"] = STORE_SCHEMA
+                        f.attrs["schema_version"] = STORE_VERSION
+                        f.attrs["created"] = _time.time()
+                        str_t = h5py.string_dtype()
+                        for k in TABLES:
+                            f.create_dataset(k, shape=(0,), maxshape=(None,), dtype=str_t, chunks=(256,))
+                        f.create_group("raw")
+                    with f:
+                        self._append(f, __version__)
+                    seal(tmp)
+        except (OSError, RuntimeError) as exc:   # a write failed: the temporary copy is gone, the store intact
+            raise ParameterError(f"store {str(self.path)!r}: the commit could not be written ({exc}); the store "
+                                 "keeps its last commit and these rows are still pending: free space and commit "
+                                 "again") from None
         n0 = self._n["measurements"]
         new = [(_hash_key(r["sha256"]), n0 + i) for i, r in enumerate(self._pending["measurements"]) if r.get("sha256")]
         if new:  # committed rows leave memory; their hashes join the sorted index (a merge, O(n))
@@ -334,6 +327,42 @@ class Store(_Queries, _Writes):
             self._pending[k] = []
         self._pending_meas = {}
         self._raw_pending = {}
+
+    def _room_for_commit(self) -> None:
+        """A commit writes a copy of the store plus the pending rows and raw records: refused before a byte
+        is written when the disk or the process's file-size limit cannot take it (HDF5 left mid-write by a
+        full disk can crash the process)."""
+        import resource
+        old = self.path.stat().st_size if self.path.exists() else 0
+        rows = sum(len(json.dumps(r, allow_nan=True)) for k in TABLES for r in self._pending[k])
+        raw = sum(np.asarray(rec.data).nbytes for rec in self._raw_pending.values())
+        need = old + rows + raw + (1 << 20)          # 1 MiB for HDF5's own structures
+        free = shutil.disk_usage(self.path.parent).free
+        limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+        room = min(free, limit if limit != resource.RLIM_INFINITY else free)
+        if need > room:
+            what = "free space on its disk" if room == free else "the process's file-size limit (ulimit -f)"
+            raise ParameterError(f"store {str(self.path)!r}: a commit needs up to {need:,} bytes (a copy of the store "
+                                 f"and {rows + raw:,} new) and {what} is {room:,}; nothing was written, the "
+                                 "rows are still pending: free space and commit again")
+
+    def _append(self, f, version: str) -> None:
+        """The pending rows and raw records into an open copy of the store."""
+        f.attrs["written_by"] = f"vibmeasure {version}"
+        for k in TABLES:
+            new = self._pending[k]
+            if not new:
+                continue
+            d = f[k]
+            n0 = d.shape[0]
+            d.resize((n0 + len(new),))
+            d[n0:] = [json.dumps(r, allow_nan=True) for r in new]
+        for mid, rec in self._raw_pending.items():
+            d = f["raw"].create_dataset(mid, data=np.asarray(rec.data), compression="gzip", compression_opts=1)
+            d.attrs["fs"] = rec.fs
+            d.attrs["t0"] = rec.t0
+            d.attrs["channels"] = json.dumps([{"name": c.name, "quantity": c.quantity, "unit": c.unit,
+                                               "location": c.location} for c in rec.channels])
 
     def __repr__(self) -> str:
         n = {k: self._n[k] + len(self._pending[k]) for k in TABLES}

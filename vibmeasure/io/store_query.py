@@ -7,7 +7,7 @@ import json
 import numpy as np
 
 from ..core.errors import ParameterError
-from ._store_common import TASK_ALIASES, _hash_key, _seconds
+from ._store_common import TASK_ALIASES, _hash_key, _seconds, check_row
 
 
 class _Queries:
@@ -18,9 +18,10 @@ class _Queries:
         committed: a later commit by another writer only appends)."""
         d = f[table].asstr()
         n = min(self._n[table], d.shape[0])
+        src = f"store {str(self.path)!r}"
         for i0 in range(0, n, chunk):
             for v in d[i0:min(i0 + chunk, n)]:
-                yield json.loads(v)
+                yield check_row(table, json.loads(v), src)
 
     def _each(self, table):
         """Every row of a table, committed (streamed from the file) then pending."""

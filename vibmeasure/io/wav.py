@@ -16,9 +16,27 @@ from ._common import DEFAULT_MAX_SAMPLES, atomic_path, check_size, make_record
 _FULL_SCALE = {np.dtype("int16"): 32768.0, np.dtype("int32"): 2147483648.0, np.dtype("uint8"): 128.0}
 
 
+_BITS = (8, 16, 24, 32, 64)   # the PCM and float sample sizes a WAV file can hold
+
+
+def _check_format(path, src: str) -> None:
+    """The format chunk's sample size must be one a WAV file holds: 0 or 12 bits are crafted, not recorded."""
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16)
+    for cid, off, size in _chunks(head):
+        if cid == b"fmt " and size >= 16 and off + 16 <= len(head):
+            channels = struct.unpack("<H", head[off + 2:off + 4])[0]
+            bits = struct.unpack("<H", head[off + 14:off + 16])[0]
+            if bits not in _BITS or channels == 0:
+                raise ParameterError(f"{src}: its format chunk declares {bits} bits per sample and {channels} "
+                                     f"channel(s); a WAV record has {_BITS} bits and at least one channel")
+            return
+
+
 def read_wav(path, *, fs=None, channels=None, quantity=None, unit=None, max_samples=DEFAULT_MAX_SAMPLES) -> Record:
     from scipy.io import wavfile
     src = f"WAV file {str(path)!r}"
+    _check_format(path, src)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", wavfile.WavFileWarning)

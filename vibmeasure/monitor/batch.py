@@ -432,6 +432,9 @@ def _client(client, workers, scheduler):
             return Client(scheduler, timeout=30), True
         except (OSError, TimeoutError) as exc:
             raise ParameterError(f"scheduler={scheduler!r}: no Dask scheduler answers there ({exc})") from None
+        except (ValueError, TypeError) as exc:
+            raise ParameterError(f"scheduler={scheduler!r} is not a scheduler address ({exc}); the form is "
+                                 "tcp://HOST:PORT") from None
     if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
         raise ParameterError(f"workers={workers!r} must be an integer >= 1")
     import dask

@@ -131,16 +131,17 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
             secs, row = analyse_input(p, rpm=rpm, bearing=bearing, band=band, model=model)
             sections += secs
             prov.append(row)
-        except (VibMeasureError, OSError, ValueError) as exc:
-            sections.append(error_section(Path(p).name, exc))
-            prov.append({"input": Path(p).name, "sha256": file_sha256(p) if Path(p).is_file() else "(missing)",
+        except Exception as exc:   # noqa: BLE001 - one input's failure is its section, never the report's
+            sections.append(error_section(Path(str(p)).name, exc))
+            prov.append({"input": Path(str(p)).name,
+                         "sha256": file_sha256(p) if Path(str(p)).is_file() else "(missing)",
                          "method": "not analysed"})
     if store is not None:
         try:
             name, digest = _store_provenance(store)
             sections.append(fleet_section(store, name))
             prov.append({"input": name, "sha256": digest, "method": "trend"})
-        except (VibMeasureError, OSError, ValueError) as exc:
+        except Exception as exc:   # noqa: BLE001 - the fleet's failure is its section, never the report's
             sections.append(error_section(str(store), exc))
     if not sections:
         raise ParameterError("nothing to report: give input files and/or a store")

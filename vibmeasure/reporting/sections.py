@@ -194,5 +194,5 @@ def fleet_section(store, name):
 
 
 def error_section(name, exc):
-    return {"kind": "error", "title": f"Input: {name}", "error": f"{type(exc).__name__}: {exc}", "tables": [],
+    return {"kind": "error", "title": f"Input: {name}", "error": f"{type(exc).__name__}: {str(exc)[:500]}", "tables": [],
             "figures": [], "flags": []}

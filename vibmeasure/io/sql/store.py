@@ -237,8 +237,10 @@ class SQLStore(_SQLQueries):
         self._need_writable()
         if self._results_out:
             self._run(sa.text("SELECT 1"))   # sends them
+        from .._common import write_errors_not_signals
         try:
-            self._conn.commit()
+            with write_errors_not_signals():   # a file-size limit: SQLite reports it, the process lives
+                self._conn.commit()
         except sa.exc.OperationalError as exc:
             self._raise_operational(exc)
         self._n_pending = 0
