@@ -542,3 +542,24 @@ def test_read_frf_of_a_mat_checks_what_an_frf_is(tmp_path):
         vm.read_frf(_frf_case(tmp_path, H=H, freq=np.r_[f[:-1], np.nan]), variable="H")
     with pytest.raises(vm.ParameterError, match="finite and increasing"):
         vm.read_frf(_frf_case(tmp_path, H=H, freq=f[::-1]), variable="H")
+
+
+def test_a_two_output_uff_cut_after_its_second_opening_line_is_named(tmp_path):
+    """Issue 48: a file cut right after a dataset's opening -1 line ends with -1 too; it was read as one
+    output."""
+    import pyuff
+    f = np.linspace(1, 100, 64)
+    p = tmp_path / "two.uff"
+    u = pyuff.UFF(str(p))
+    for k in (1, 2):
+        u.write_sets(pyuff.prepare_58(func_type=4, rsp_node=k, rsp_dir=3, ref_node=1, ref_dir=3, binary=0,
+                                      data=(k / (1000 - (2 * np.pi * f) ** 2 + 1j * f)).astype(complex), x=f,
+                                      id1=f"out{k}", rsp_ent_name=f"out{k}", ref_ent_name="force",
+                                      abscissa_spacing=1, ordinate_spec_data_type=8, orddenom_spec_data_type=13,
+                                      abscissa_spec_data_type=18), mode="add")
+    assert vm.read_frf(p).h.shape[0] == 2
+    raw = p.read_bytes()
+    second = raw.index(b"    -1", raw.index(b"    -1", raw.index(b"    -1") + 6) + 6)   # the 2nd dataset's opening
+    p.write_bytes(raw[:second + 7])
+    with pytest.raises(vm.ParameterError, match="odd number"):
+        vm.read_frf(p)

@@ -63,6 +63,29 @@ def test_lvm_cut_at_any_line_end_or_inside_a_number_is_refused(tmp_path):
     for k in range(raw.index(b"X_Value"), len(raw) - 1):
         p.write_bytes(raw[:k])
         assert _outcome(p, original) == "named", k
+    # issue 48: the whole file but its last end of line is complete, and is read exactly
+    p.write_bytes(raw[:-1])
+    assert _outcome(p, original) == "exact"
+
+
+def _spectrum_lvm(tmp_path, rows, label="Acceleration (FFT - (RMS))"):
+    p = tmp_path / "s.lvm"
+    p.write_text("LabVIEW Measurement\t\nSeparator\tTab\n***End_of_Header***\t\n\nChannels\t1\t\n"
+                 "X_Dimension\tTime\t\n***End_of_Header***\t\n"
+                 f"X_Value\t{label}\tComment\n" + "\n".join(f"{f}\t{v}" for f, v in rows) + "\n")
+    return p
+
+
+@pytest.mark.parametrize("rows,label,rule", [
+    ([(0, -70.0), (1, float("nan")), (2, -80.0)], "Acceleration (FFT - (RMS))", "finite values"),
+    ([(2, -70.0), (1, -75.0), (0, -80.0)], "Acceleration (FFT - (RMS))", "increasing"),
+    ([(0, -70.0), (1, 9000.0), (2, -80.0)], "Acceleration (FFT - (RMS))", "beyond any sensor"),
+    ([(0, 0.5), (0.001, -0.7), (0.002, 0.2)], "Voltage", "a time record"),
+])
+def test_crafted_lvm_spectra_are_named(tmp_path, rows, label, rule):
+    """Issue 48: LVM spectra with NaN, falling frequency, absurd dB values, or a waveform were read."""
+    with pytest.raises(vm.ParameterError, match=rule):
+        vm.read_spectrum(_spectrum_lvm(tmp_path, rows, label))
 
 
 def test_a_complete_last_row_without_newline_is_data_and_a_cut_one_is_named(tmp_path):

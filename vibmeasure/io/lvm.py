@@ -11,6 +11,7 @@ from ..core.errors import ParameterError, UnitError
 from ..core import units as _units
 from ..core.record import Record
 from ..core._validate import select_names
+from .csvfile import _incomplete
 from ._common import DEFAULT_MAX_SAMPLES, check_size, make_record, parse_number, require_fs
 
 _END = "***End_of_Header***"
@@ -79,8 +80,12 @@ def _lvm_values(rows: list, text: str, header: dict, sep: str, dec: str, src: st
         raise ParameterError(f"{src} has no data rows")
     check_size(len(rows) * (rows[0].count(sep) + 1), source=src, max_samples=max_samples)
     if not text.endswith(("\n", "\r")):
-        raise ParameterError(f"{src}: the last line {rows[-1][:60]!r} has no end of line: the file was cut "
-                             "(LabVIEW ends every line)")
+        # a last line without its end of line is data when it is complete (a hand edit, another writer);
+        # one that cannot be complete was cut
+        why = _incomplete(rows[-1], rows[-50:-1])
+        if why:
+            raise ParameterError(f"{src}: the last line {rows[-1][:60]!r} {why} and has no end of line: the file "
+                                 "was cut")
     stated = [parse_number(v, source=src, key="header Samples") for v in header.get("Samples", [])]
     if stated and any(v != len(rows) for v in stated):
         raise ParameterError(f"{src}: the header states {int(max(stated))} samples per channel but the file holds "
@@ -137,6 +142,9 @@ def _lvm_columns(values, header: dict, names, src: str):
     return values, ychan, file_fs, t0, file_unit
 
 
+DB_LIMIT = 300.0   # dB re 1 unit: 1e15 or 1e-15 of the unit, beyond every measurement chain
+
+
 def read_lvm_spectrum(path):
     """A LabVIEW FFT export: frequency in the X column, magnitude (dB re 1 unit when the channel says
     so, else linear); returns an amplitude Spectrum."""
@@ -162,10 +170,23 @@ def read_lvm_spectrum(path):
         arr = np.array([[float(v) for v in r[:2]] for r in rows])
     except (ValueError, IndexError):
         raise ParameterError(f"{src}: spectrum rows are not numbers (truncated file?)") from None
+    if arr.ndim != 2 or arr.shape[0] < 2:
+        raise ParameterError(f"{src}: {arr.shape[0] if arr.ndim else 0} spectrum line(s); a spectrum needs at least 2")
     freq, val = arr[:, 0], arr[:, 1]
     label = names[1].strip() if len(names) > 1 else "ch0"
+    # LabVIEW states X_Dimension "Time" on FFT exports too, so the values decide: a channel not named as a
+    # spectrum whose values swing both ways is a waveform (a magnitude is >= 0; dB are named so)
+    spectral = any(k.lower() in label.lower() for k in ("FFT", "Spectrum", "Power", "PSD", "dB", "Magnitude"))
+    if not spectral and val.min() < 0 < val.max():
+        raise ParameterError(f"{src}: channel {label!r} swings above and below 0 and is not named as a spectrum: "
+                             "a time record, which vm.read reads")
+    if not (np.all(np.isfinite(arr)) and np.all(np.diff(freq) > 0) and freq[0] >= 0):
+        raise ParameterError(f"{src}: the spectrum must hold finite values at frequencies from >= 0 Hz, increasing")
     unit_lab = (head.get("Y_Unit_Label") or [""])[0]
     is_db = "dB" in label or (val < 0).any()
+    if is_db and np.max(np.abs(val)) > DB_LIMIT:
+        raise ParameterError(f"{src}: a level of {val[np.argmax(np.abs(val))]:g} dB is beyond any sensor "
+                             f"(+-{DB_LIMIT:g} dB re 1 unit): not a spectrum in dB")
     amp = 10 ** (val / 20) if is_db else val
     try:
         unit = _units.normalize_unit(unit_lab)

@@ -27,6 +27,15 @@ def _check_complete(path):
     if not tail.rstrip().endswith(b"-1"):
         raise ParameterError(f"UFF file {str(path)!r} does not end with the dataset delimiter -1: the file was "
                              "cut inside its last dataset")
+    # each dataset opens and closes with a line "    -1": an odd count is a file cut after a dataset's
+    # opening line (its tail then ends with -1 too)
+    with open(path, "rb") as fh:
+        lines = [line.strip() for line in fh]
+    n = sum(1 for line in lines if line == b"-1")
+    binary = any(line.startswith(b"58b") for line in lines)   # 58b: binary blocks, no line structure to count
+    if n % 2 and not binary:
+        raise ParameterError(f"UFF file {str(path)!r} has {n} dataset delimiters (-1 lines), an odd number: its "
+                             "last dataset was cut after its opening line")
 
 
 def uff_sets(path):
