@@ -94,13 +94,54 @@ def mutations(raw: bytes, fmt: str, n_flips: int, rng: random.Random):
     yield from crafted(raw, fmt)
 
 
+def _crafted_h5(**kw) -> bytes:
+    """A record file in vibmeasure's schema, unsealed, with one part wrong (the lazy path's cases)."""
+    import h5py
+    data = kw.pop("data", np.zeros((2, 100)))
+    names = kw.pop("names", ("a", "b"))
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "c.h5"
+        with h5py.File(p, "w") as f:
+            f.attrs["vibmeasure_schema"] = "vibmeasure.record"
+            f.attrs["schema_version"] = 1
+            f.attrs["meta"] = kw.pop("meta", "{}")
+            if not kw.pop("no_data", False):
+                d = f.create_dataset("data", data=data)
+                attrs = {"fs": kw.pop("fs", 100.0), "t0": 0.0, "channel_names": list(names),
+                         "channel_quantities": ["unknown"] * len(names), "channel_units": [""] * len(names),
+                         "channel_locations": [""] * len(names)}
+                for k, v in attrs.items():
+                    if k not in kw.get("drop", ()):
+                        d.attrs[k] = v
+        return p.read_bytes()
+
+
 def crafted(raw: bytes, fmt: str):
+    if fmt == "h5":
+        yield "no names", _crafted_h5(drop=("channel_names",))
+        yield "fs as text", _crafted_h5(fs="abc")
+        yield "fs negative", _crafted_h5(fs=-5.0)
+        yield "bad JSON meta", _crafted_h5(meta="{not json")
+        yield "complex data", _crafted_h5(data=np.zeros((2, 100)) + 1j)
+        yield "empty data", _crafted_h5(data=np.zeros((2, 0)))
+        yield "3 names for 2 rows", _crafted_h5(names=("a", "b", "c"))
+        yield "no data", _crafted_h5(no_data=True)
     if fmt == "wav":
         b = bytearray(raw)
         i = raw.find(b"data")
         if i > 0:
             b[i + 4: i + 8] = struct.pack("<I", 0xFFFFFFF0)   # a data chunk declaring 4 GiB
             yield "declares 4 GiB", bytes(b)
+        j = raw.find(b"fmt ")
+        if j > 0:
+            for bits in (0, 12):
+                b = bytearray(raw)
+                b[j + 8 + 14: j + 8 + 16] = struct.pack("<H", bits)
+                yield f"{bits} bits per sample", bytes(b)
+            if i > 0:
+                b = bytearray(raw[:i + 8])
+                b[i + 4: i + 8] = struct.pack("<I", 0)
+                yield "empty data chunk", bytes(b)
     if fmt == "csv":
         txt = raw.decode()
         yield "fs with thousands separator", txt.replace("# fs_hz = 1000.0", "# fs_hz = 1,000").encode()
@@ -110,6 +151,7 @@ def crafted(raw: bytes, fmt: str):
     if fmt == "lvm":
         txt = raw.decode()
         yield "Samples says more", txt.replace("Samples\t400\t400", "Samples\t500\t500").encode()
+        yield "complete last line, no end of line", txt.rstrip("\r\n").encode()
 
 
 def classify(path, original, source_fmt):
@@ -124,6 +166,15 @@ def classify(path, original, source_fmt):
             return f"raw:{type(exc).__name__}"
     flagged = any(issubclass(w.category, vm.QualityWarning) for w in caught)
     same = rec.data.shape == original.shape and np.array_equal(rec.data, original)
+    if source_fmt == "h5":   # the lazy reader must agree with the eager one
+        try:
+            lazy = vm.open(path).load().data
+        except vm.ParameterError:
+            return "raw:open refused what read took"
+        except Exception as exc:  # noqa: BLE001 - counted as a defect
+            return f"raw:open {type(exc).__name__}"
+        if not np.array_equal(lazy, rec.data):
+            return "silent"
     return "exact" if same else "flagged" if flagged else "silent"
 
 

@@ -192,6 +192,13 @@ def check_band(band, fs: float, *, name: str = "band") -> tuple[float, float] | 
     return lo, hi
 
 
+def file_kind(mode: int) -> str:
+    """What a path that is not a regular file is, in words."""
+    import stat
+    return ("a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode)
+            else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else "a special file")
+
+
 def regular_input(path, name: str = "path", *, max_bytes: int | None = None):
     """``path`` as a Path to an existing regular file of at most ``max_bytes``: a folder, FIFO, device or
     socket is refused by name before it is opened (reading /dev/zero or a FIFO never ends)."""
@@ -205,9 +212,8 @@ def regular_input(path, name: str = "path", *, max_bytes: int | None = None):
     except OSError as exc:
         raise ParameterError(f"{name}={str(path)!r} cannot be inspected: {exc.strerror or exc}") from None
     if not stat.S_ISREG(st.st_mode):
-        kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode)
-                else "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "a special file")
-        raise ParameterError(f"{name}={str(path)!r} is {kind}, not a file: the rule is, inputs are regular files")
+        raise ParameterError(f"{name}={str(path)!r} is {file_kind(st.st_mode)}, not a file: the rule is, inputs are "
+                             "regular files")
     if max_bytes is not None and st.st_size > max_bytes:
         raise ParameterError(f"{name}={str(path)!r} is {st.st_size:,} bytes, above the {max_bytes:,} this input "
                              "takes")

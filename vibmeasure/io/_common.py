@@ -85,10 +85,9 @@ def _check_target(path: Path) -> int | None:
     except FileNotFoundError:
         return None
     if not stat.S_ISREG(st.st_mode):
-        kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode)
-                else "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "a special file")
-        raise ParameterError(f"path={str(path)!r} is {kind}; the rule is: output goes to a regular file "
-                             "(it is never replaced by one)")
+        from ..core._validate import file_kind
+        raise ParameterError(f"path={str(path)!r} is {file_kind(st.st_mode)}; the rule is: output goes to a regular "
+                             "file (it is never replaced by one)")
     return stat.S_IMODE(st.st_mode)
 
 
