@@ -563,3 +563,17 @@ def test_a_two_output_uff_cut_after_its_second_opening_line_is_named(tmp_path):
     p.write_bytes(raw[:second + 7])
     with pytest.raises(vm.ParameterError, match="odd number"):
         vm.read_frf(p)
+
+
+def test_a_mat_header_with_a_negative_dimension_is_named(tmp_path):
+    import struct
+
+    import scipy.io as sio
+    p = tmp_path / "neg.mat"
+    sio.savemat(p, {"x": np.arange(12.0).reshape(3, 4), "fs": 100.0}, do_compression=False)
+    raw = bytearray(p.read_bytes())
+    i = raw.find(struct.pack("<IIii", 5, 8, 3, 4))      # the dims sub-element: int32 x 2
+    raw[i + 8:i + 12] = struct.pack("<i", -3)
+    p.write_bytes(bytes(raw))
+    with pytest.raises(vm.ParameterError, match="dimension below 0"):
+        vm.read(p)

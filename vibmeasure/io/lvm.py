@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.errors import ParameterError, UnitError
+from ..core.errors import ParameterError, UnitError, warn_quality
 from ..core import units as _units
 from ..core.record import Record
 from ..core._validate import select_names
@@ -72,6 +72,17 @@ def _lvm_header(lines: list, src: str):
     return header, sep, dec, body_start, names
 
 
+def _fixed_width(rows: list) -> bool:
+    """Whether every column of these rows has one number of decimals (LabVIEW's fixed format), so that a
+    last line cut inside a number shows."""
+    import re
+    fields = [re.findall(r"[^,;\t ]+", r) for r in rows]
+    if len(fields) < 2 or len({len(f) for f in fields}) != 1:
+        return False
+    return all(len({len(f[k].split(".")[1]) if f[k].count(".") == 1 else None for f in fields} - {None}) == 1 and
+               all(f[k].count(".") == 1 for f in fields) for k in range(len(fields[0])))
+
+
 def _lvm_values(rows: list, text: str, header: dict, sep: str, dec: str, src: str, max_samples):
     """The data rows as numbers, checked: size before reading, a complete last line, the header's
     sample count, no missing value."""
@@ -86,6 +97,10 @@ def _lvm_values(rows: list, text: str, header: dict, sep: str, dec: str, src: st
         if why:
             raise ParameterError(f"{src}: the last line {rows[-1][:60]!r} {why} and has no end of line: the file "
                                  "was cut")
+        if not _fixed_width(rows[-50:-1]):
+            warn_quality(f"{src}: the last line {rows[-1][:60]!r} has no end of line and its columns have no fixed "
+                         "number of decimals, so a cut inside its last number cannot be told: kept, check it",
+                         stacklevel=5)
     stated = [parse_number(v, source=src, key="header Samples") for v in header.get("Samples", [])]
     if stated and any(v != len(rows) for v in stated):
         raise ParameterError(f"{src}: the header states {int(max(stated))} samples per channel but the file holds "

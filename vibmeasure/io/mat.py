@@ -63,6 +63,9 @@ def _leaves_v5(path, max_samples: int | None = None) -> dict[str, np.ndarray]:
     try:
         if max_samples is not None:  # the declared sizes, before any variable is decompressed
             for name, shape, _cls in sio.whosmat(path):
+                if any(int(d) < 0 for d in shape):
+                    raise ParameterError(f"MAT file {str(path)!r}: variable {name!r} declares the shape {shape}; "
+                                         "a dimension below 0 is a damaged header")
                 check_size(int(np.prod(shape, dtype=np.float64)), source=f"MAT file {str(path)!r}",
                            max_samples=max_samples, what=f"variable {name!r}")
             # nested struct fields and cells are not in whosmat: their inflated bytes, at 8 a sample
