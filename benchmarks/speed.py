@@ -78,7 +78,7 @@ def peaks():
                                          9)
         ev = np.max(np.abs(np.sort(pk.freq) - f)) / spec.df
         ep = np.max(np.abs(np.sort(pp) - f)) / spec.df
-        row(f"2^{p} samples (error: vm {ev:.1e} bin, peer {ep:.1e} bin)", tv, tp, "vm within 2x of peer")
+        row(f"2^{p} samples (error: vm {ev:.1e} bin, peer {ep:.1e} bin)", tv, tp, "vm within 1.5x of peer (issue 50)")
 
 
 # 2, 3 ---------------------------------------------------------------------------------------------

@@ -71,6 +71,37 @@ def _W_cos(c, N, nfft, d):
     return abs(total)
 
 
+def _W_cos_many(c, N, nfft, d):
+    """``_W_cos`` at many offsets at once (for the inverse table)."""
+    d = np.asarray(d, float)
+    th = 2 * np.pi * d / nfft
+
+    def dirichlet(x):
+        s = np.sin(0.5 * x)
+        small = np.abs(s) < 1e-300
+        core = np.where(small, float(N), np.sin(0.5 * N * x) / np.where(small, 1.0, s))
+        return np.exp(-0.5j * x * (N - 1)) * core
+
+    total = c[0] * dirichlet(th)
+    for m in range(1, len(c)):
+        ph = 2 * np.pi * m / N
+        total = total + 0.5 * c[m] * (dirichlet(th - ph) + dirichlet(th + ph))
+    return np.abs(total)
+
+
+@lru_cache(maxsize=32)
+def _inverse_ratio(c, N, nfft):
+    """d as a function of the neighbour ratio alpha = W(1 - d) / W(d), 0 <= d <= 1/2, for one window:
+    a cubic spline through 513 exact points (its start is within 1e-9 bin; one Newton step on the exact
+    ratio then reaches round-off), or None where the ratio is not monotone."""
+    from scipy.interpolate import CubicSpline
+    d = np.linspace(0.0, 0.5, 513)
+    alpha = _W_cos_many(c, N, nfft, 1.0 - d) / _W_cos_many(c, N, nfft, d)
+    if not np.all(np.isfinite(alpha)) or not np.all(np.diff(alpha) > 0):
+        return None
+    return CubicSpline(alpha, d)
+
+
 def _linear_magnitude(spec: Spectrum, ch: int) -> np.ndarray:
     v = np.abs(spec.values[ch])
     return np.sqrt(v) if spec.kind in ("psd", "power") else v
@@ -100,6 +131,12 @@ def interpolate_peak(mag: np.ndarray, k: int, *, window=None, nperseg=None, nfft
                 Wd = lambda d: _W(win, nfft, d)  # noqa: E731
             w0 = Wd(0.0)
             f = lambda d: Wd(1.0 - d) / Wd(d) - alpha  # noqa: E731
+            inv = _inverse_ratio(coef, int(nperseg), int(nfft)) if coef is not None else None
+            if inv is not None and inv.x[0] <= alpha <= inv.x[-1]:
+                d = float(inv(alpha))                      # within 1e-9 bin
+                slope = float(inv(alpha, 1))               # dd / dalpha
+                d = min(max(d - f(d) * slope, 0.0), 0.5)   # one Newton step on the exact ratio
+                return k + side * d, b * w0 / Wd(d)
             lo_v, hi_v = f(0.0), f(0.5)
             if lo_v <= 0 <= hi_v:
                 d = brentq(f, 0.0, 0.5, xtol=1e-12) if lo_v < 0 < hi_v else (0.0 if lo_v == 0 else 0.5)
@@ -185,7 +222,7 @@ def pick_peaks(spec: Spectrum, *, n: int | None = None, prominence: float | None
     if n is not None:
         order = order[:n]
     idx, proms = idx[order], proms[order]
-    mag = _linear_magnitude(spec, ch)
+    mag = np.sqrt(vals) if spec.kind in ("psd", "power") else vals    # _linear_magnitude, |values| reused
     p = spec.params
     freqs, amps = [], []
     for k in idx:
