@@ -7,6 +7,12 @@ against scipy's lsim (exact for the linearly interpolated input) at a few freque
 
 Target (issue 15): < 1 s.
 
+Then issue 50's case side by side with endaq's ``shock_spectrum`` when endaq is installed
+(``pip install endaq``; not a vibmeasure dependency): 2^17 samples of a random shock at 20 kHz, 108
+oscillators 10 Hz - 4.8 kHz (1/12 octave), 5 % damping; the error of each against the exact response
+of the linearly interpolated input (scipy lsim at 256 points a cycle) at six frequencies up to fs/4.
+Target: vm.srs <= 1.5x endaq, within 0.5 % of exact at every oscillator up to fs/4.
+
     python benchmarks/shock.py
 """
 
@@ -61,5 +67,48 @@ def main():
         print(f"    {fn[k]:8.1f} Hz  vm {sp['maximax'][k] / ref - 1:+.2e}   textbook {tb[k] / ref - 1:+.2e}")
 
 
+def against_endaq():
+    fs, n = 20000.0, 2 ** 17
+    rng = np.random.default_rng(0)
+    x = np.r_[np.zeros(2000), rng.normal(size=n - 2000) * np.exp(-np.arange(n - 2000) / 4000.0)] * 50 * 9.81
+    rec = vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="m/s^2")
+    fn = 10.0 * 2 ** (np.arange(108) / 12)
+    print(f"\n2^17 samples at 20 kHz, {fn.size} oscillators {fn[0]:g} Hz - {fn[-1]:.0f} Hz (1/12 octave), zeta 0.05")
+    try:
+        import pandas as pd
+        from endaq.calc.shock import shock_spectrum
+    except ImportError:
+        shock_spectrum = None
+        print("  (endaq not installed: pip install endaq to compare)")
+    t_vm, t_en = [], []
+    df = None
+    for _ in range(5):
+        t0 = time.perf_counter()
+        sp = vm.srs(rec, fn=fn, zeta=0.05)
+        t_vm.append(time.perf_counter() - t0)
+        if shock_spectrum is not None:
+            df = pd.DataFrame({"x": x}, index=pd.Index(np.arange(n) / fs, name="time"))
+            t0 = time.perf_counter()
+            en = shock_spectrum(df, freqs=fn, damp=0.05, mode="srs", max_time=None)
+            t_en.append(time.perf_counter() - t0)
+    line = f"  vm.srs {statistics.median(t_vm):.3f} s"
+    if t_en:
+        line += f"   endaq shock_spectrum {statistics.median(t_en):.3f} s   vm / endaq {statistics.median(t_vm) / statistics.median(t_en):.2f}x (target <= 1.5x)"
+    print(line)
+    t = np.arange(40000) / fs
+    for f in (100.0, 761.0, 1500.0, 2280.0, 3400.0, 4800.0):
+        k = int(np.argmin(np.abs(fn - f)))
+        w = 2 * np.pi * fn[k]
+        m = max(1, int(np.ceil(256 * fn[k] / fs)))
+        tf = np.arange((t.size - 1) * m + 1) / (fs * m)
+        _, y, _ = lsim(([0.1 * w, w * w], [1.0, 0.1 * w, w * w]), np.interp(tf, t, x[:t.size]), tf)
+        ref = np.max(np.abs(y))
+        row = f"    {fn[k]:8.1f} Hz  vm {sp['maximax'][k] / ref - 1:+.2e}"
+        if t_en:
+            row += f"   endaq {float(np.asarray(en).ravel()[k]) / ref - 1:+.2e}"
+        print(row)
+
+
 if __name__ == "__main__":
     main()
+    against_endaq()

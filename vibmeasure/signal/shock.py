@@ -4,9 +4,11 @@
 acceleration, by the ramp-invariant recursive filter (Smallwood 1981; ISO 18431-4): each
 oscillator's response is exact at the samples for a base acceleration linear between them (and
 zero before the record).
-Oscillators whose natural frequency is above fs/32 run on a linearly interpolated (finer) copy of
-the input, which is the same piecewise-linear input, so their peaks are sampled finely too; each
-peak is then refined by a parabola through its three samples.
+Every oscillator runs on the record's own samples. Where it has fewer than 32 samples a cycle (above
+fs/32) the true extreme may lie between samples: the state at a sample follows from two outputs, and
+the exact response of the piecewise-linear input is evaluated at 32 points a cycle over the steps
+next to samples that come within cos(pi / P) of the sampled extreme (only there can it be beaten);
+each extreme is then refined by a parabola through its neighbours.
 
 ``transmissibility``: |top / base| measured by the H1 estimator with its coherence, compared with
 a model's transmissibility where one is given.
@@ -124,47 +126,91 @@ def _as_acceleration(rec: Record, idx: int, what: str):
     return x, ch.unit or ""
 
 
-def _peaks(y):
-    """Largest positive and negative values of the rows of y, each refined by a parabola."""
+def _extremes(y):
+    """Largest positive and negative values of y, each refined by a parabola through its samples."""
     out = []
-    for sign in (1.0, -1.0):
-        v = sign * y
-        i = np.argmax(v, axis=1)
-        rows = np.arange(y.shape[0])
-        top = v[rows, i]
-        inner = (i > 0) & (i < y.shape[1] - 1)
-        a = v[rows, np.clip(i - 1, 0, None)]
-        c = v[rows, np.clip(i + 1, None, y.shape[1] - 1)]
-        den = a - 2 * top + c
-        with np.errstate(invalid="ignore", divide="ignore"):
-            corr = np.where(inner & (den < 0), -(c - a) ** 2 / (8 * den), 0.0)
-        out.append(np.maximum(top + corr, 0.0))
+    for i, sign in ((int(np.argmax(y)), 1.0), (int(np.argmin(y)), -1.0)):
+        top = sign * y[i]
+        if 0 < i < y.size - 1:
+            a, c = sign * y[i - 1], sign * y[i + 1]
+            den = a - 2 * top + c
+            if den < 0:
+                top -= (c - a) ** 2 / (8 * den)
+        out.append(max(top, 0.0))
     return out
 
 
-def _response(x, fs, f, zeta, output, tail, k_end):
-    """Response of one oscillator during the pulse (samples up to k_end) and after it (the rest of the
-    record and ``tail`` seconds of free vibration with zero input), on an input linearly interpolated
-    to at least PTS_PER_CYCLE samples per cycle."""
+def _step_maps(f, zeta, fs, output, J):
+    """C and, per fraction tau = j T / J of a step (j = 1 .. J, the last the whole step), the row vectors
+    giving the output at k T + tau from the state at k T, the input u_k and the increment u_k+1 - u_k
+    (the input linear over the step, as the filter takes it)."""
+    from scipy.linalg import expm
+    T = 1.0 / fs
+    w = 2 * np.pi * f
+    M = np.zeros((4, 4))
+    M[0, 1], M[1, 0], M[1, 1], M[1, 2], M[2, 3] = 1.0, -w * w, -2 * zeta * w, -1.0, 1.0 / T
+    C = np.array([-w * w, -2 * zeta * w]) if output == "acceleration" else np.array([1.0, 0.0])
+    E = expm(M[None] * (np.arange(1, J + 1) * T / J)[:, None, None])
+    return C, C @ E[:, :2, :2], E[:, :2, 2] @ C, E[:, :2, 3] @ C     # (2,), (J, 2), (J,), (J,)
+
+
+def _between_samples(y, u, maps, per, lo, hi):
+    """Extremes of the response between the samples of y[lo:hi], the exact response of the filter's
+    input (linear between samples), where an oscillator has fewer than PTS_PER_CYCLE samples a cycle.
+    Only intervals next to a sample within cos(pi / P) (P samples a cycle), less a margin, of the
+    sampled extreme can hold the true one; each is evaluated at PTS_PER_CYCLE points a cycle and the
+    best refined by a parabola (as an oscillator that is sampled finely enough)."""
+    out = []
+    seg = y[lo:hi]
+    reach = np.cos(np.pi / per) * 0.9
+    for sign, best in ((1.0, float(seg.max())), (-1.0, -float(seg.min()))):
+        # no signed copy of the record: compare the samples with the signed limit directly
+        k = lo + np.flatnonzero(seg >= best * reach if sign > 0 else seg <= -best * reach)
+        k = np.unique(np.concatenate([k - 1, k]))
+        k = k[(k >= lo) & (k + 1 < min(hi, y.size))]
+        if k.size:
+            out.append(max(best, _interval_max(sign, y, u, k, maps)))
+        else:
+            out.append(best)
+    return [max(v, 0.0) for v in out]
+
+
+def _interval_max(sign, y, u, k, maps):
+    """The largest of sign * response over the steps after samples k (sorted), from the states there:
+    J points a step, in time order along each run of consecutive steps, the best refined by a parabola
+    through its neighbours (across a sample as well: a step's first point is that sample)."""
+    C, CP, Cg0, Cg1 = maps
+    # the state at sample k from y_k and y_k+1: [C; C Phi] s_k = [y_k; y_k+1 - C G0 u_k - C G1 (u_k+1 - u_k)]
+    du = u[k + 1] - u[k]
+    s = np.linalg.solve(np.vstack([C, CP[-1]]), np.vstack([y[k], y[k + 1] - Cg0[-1] * u[k] - Cg1[-1] * du]))
+    fine = CP[:-1] @ s + Cg0[:-1, None] * u[k] + Cg1[:-1, None] * du    # (J - 1, K) between the samples
+    steps = np.vstack([y[k], fine]) * sign                              # (J, K): from each sample on
+    pieces = []
+    for run in np.split(np.arange(k.size), np.flatnonzero(np.diff(k) != 1) + 1):
+        pieces += [steps[:, run].ravel(order="F"), [sign * y[k[run[-1]] + 1], -np.inf]]
+    seq = np.concatenate(pieces)
+    j = int(np.argmax(seq))
+    top = float(seq[j])
+    if 0 < j < seq.size - 1 and np.isfinite(seq[j - 1]) and np.isfinite(seq[j + 1]):
+        a, c = seq[j - 1], seq[j + 1]
+        den = a - 2 * top + c
+        if den < 0:
+            top -= (c - a) ** 2 / (8 * den)
+    return top
+
+
+def _oscillator(x_ext, n, B, A, f, zeta, fs, output, tail, k_end):
+    """Primary and residual extremes (positive, negative) of one oscillator: the ramp-invariant filter
+    on the record's own samples (exact there), then between the samples where they are too coarse."""
     from scipy.signal import lfilter
-    m = max(1, int(np.ceil(PTS_PER_CYCLE * f / fs)))
-    lead = 0
-    if m > 1:
-        # the recursive filter takes the input as 0 one step before the record, so on the record's own
-        # grid the first sample is reached by a ramp of one sample (1/fs); the finer copy keeps that
-        # ramp (from 0 at -1/fs), or a record that starts away from 0 would jump in 1/(m fs)
-        t = np.arange(-1, x.size)
-        x = np.interp(np.arange(-m, (x.size - 1) * m + 1) / m, t, np.concatenate([[0.0], x]))
-        lead = m - 1   # the fine samples before t = 0 (the one at -1/fs is the filter's own zero)
-        x = x[1:]
-    fs_m = fs * m
-    b, a = srs_coefficients([f], zeta, fs_m, output)
-    n_tail = int(np.ceil(tail * fs_m)) + 2
-    xx = np.concatenate([x, np.zeros(n_tail)])
-    y = lfilter(b[0], a[0], xx)[lead:]
-    # the residual is the response from the pulse's end on, that instant included: a heavily damped
-    # response that decays from it has its residual peak there
-    return y[: k_end * m + 1], y[k_end * m:]
+    n_tail = int(np.ceil(tail * fs)) + 2
+    u = x_ext[:n + n_tail]
+    y = lfilter(B, A, u)
+    per = fs / f
+    if per >= PTS_PER_CYCLE:
+        return _extremes(y[:k_end + 1]), _extremes(y[k_end:])
+    maps = _step_maps(f, zeta, fs, output, int(np.ceil(PTS_PER_CYCLE / per)))
+    return _between_samples(y, u, maps, per, 0, k_end + 1), _between_samples(y, u, maps, per, k_end, y.size)
 
 
 def srs(rec, *, fn=None, zeta: float | None = None, Q: float | None = None, kind: str = "maximax",
@@ -234,14 +280,13 @@ def srs(rec, *, fn=None, zeta: float | None = None, Q: float | None = None, kind
     if k_end > x.size - 1:
         raise ParameterError(f"pulse_end={pulse_end} s is after the record's end ({(x.size - 1) / rec.fs:g} s)")
     prim, resid = np.zeros((2, f.size)), np.zeros((2, f.size))
+    B, A = srs_coefficients(f, z, rec.fs, filt)
+    # the free vibration's positive and negative extrema follow each other half a damped period apart,
+    # so both are within its first damped period (1/fd, fd = fn sqrt(1 - zeta^2)), plus margin
+    tails = 1.25 / (f * np.sqrt(1.0 - z * z))
+    x_ext = np.concatenate([x, np.zeros(int(np.ceil(tails.max() * rec.fs)) + 2)])
     for k, fk in enumerate(f):
-        # the free vibration's positive and negative extrema follow each other half a damped period
-        # apart, so both are within its first damped period (1/fd, fd = fn sqrt(1 - zeta^2)), plus margin
-        y_p, y_r = _response(x, rec.fs, fk, z, filt, 1.25 / (fk * np.sqrt(1.0 - z * z)), k_end)
-        (pp,), (pn,) = _peaks(y_p[None])
-        (rp,), (rn,) = _peaks(y_r[None])
-        prim[:, k] = pp, pn
-        resid[:, k] = rp, rn
+        prim[:, k], resid[:, k] = _oscillator(x_ext, x.size, B[k], A[k], fk, z, rec.fs, filt, tails[k], k_end)
     scale = np.ones_like(f)
     out_unit = "m/s^2"
     if output == "pseudo_velocity":
