@@ -230,3 +230,35 @@ class _Buf:
 def test_a_postgresql_server_that_cannot_be_reached_is_named():
     with pytest.raises(vm.ParameterError, match="cannot be used"):
         vm.Store("postgresql://nobody@127.0.0.1:1/none", timeout=2)
+
+
+@pytest.mark.parametrize("column,value", [("summary", "{not json"), ("params", "[1, 2]"), ("summary", "1, 2")])
+def test_a_database_store_with_crafted_rows_is_named(tmp_path, column, value):
+    """Issue 48's attacks on the database store: a stored value that is not JSON, or not the mapping a
+    summary or params is, ends in a ParameterError, not a raw JSONDecodeError or TypeError."""
+    import sqlite3
+    p = tmp_path / "plant.db"
+    with vm.Store(p, writable=True) as st:
+        st.add_asset("pump-1")
+        st.add_point("pump-1", "DE")
+        mid = st.add_measurement("pump-1", "DE", time="2026-11-22T08:00", rpm=1797)
+        st.add_result(mid, "diagnose", {"top": "none"}, summary={"top": "none"})
+    con = sqlite3.connect(p)
+    con.execute(f"UPDATE results SET {column} = ?", (value,))
+    con.commit()
+    con.close()
+    with pytest.raises(vm.ParameterError, match="damaged"):
+        vm.Store(p).results("diagnose")
+
+
+def test_a_symlinked_database_store_writes_the_real_file(tmp_path):
+    """Issue 48's symlink attack on the database store: the path is resolved, so the link stays a link
+    and both names see the same rows."""
+    real, link = tmp_path / "plant.db", tmp_path / "alias.db"
+    with vm.Store(real, writable=True) as st:
+        st.add_asset("pump-1")
+    link.symlink_to(real)
+    with vm.Store(link, writable=True) as st:
+        st.add_asset("pump-2")
+    assert link.is_symlink()
+    assert sorted(vm.Store(real).assets()["asset"]) == ["pump-1", "pump-2"]

@@ -15,6 +15,7 @@ __all__ = ["read_manifest", "MANIFEST_COLUMNS"]
 
 MANIFEST_COLUMNS = ("file", "asset", "point", "channel", "rpm", "bearing", "model", "time", "tach", "pulses_per_rev",
                     "unit", "fs")
+MAX_MANIFEST_BYTES = 256 << 20   # a manifest lists files: 256 MiB is millions of rows, more is not one
 READABLE = (".csv", ".txt", ".h5", ".hdf5", ".wav", ".mat", ".lvm", ".uff", ".unv")
 
 
@@ -48,7 +49,7 @@ def read_manifest(path) -> list[dict]:
     >>> len(vm.read_manifest(folder / "machines.csv")) > 0
     True
     """
-    p = regular_input(path, "manifest")
+    p = regular_input(path, "manifest", max_bytes=MAX_MANIFEST_BYTES)
     src = f"manifest {str(path)!r}"
     try:
         with open(p, newline="", encoding="utf-8-sig") as fh:

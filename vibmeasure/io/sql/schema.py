@@ -10,6 +10,8 @@ import json
 import re
 from pathlib import Path
 
+from ...core.errors import ParameterError
+
 
 SQL_SUFFIXES = (".db", ".sqlite", ".sqlite3")
 _RAW_KEY = re.compile(r"^[0-9a-f]{64}$")
@@ -81,14 +83,27 @@ def _dumps(obj) -> str:
 
 
 def _loads(text):
-    return None if text is None else json.loads(text)
+    if text is None:
+        return None
+    try:
+        return json.loads(text)
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"the store is damaged: a stored value is not JSON ({exc})") from None
 
 
 def _many(texts, empty) -> list:
     """Many JSON texts parsed at once (one array: the parser's call overhead once); a NULL or JSON null
     gives ``empty`` (a fresh copy of it for each row)."""
-    values = json.loads("[" + ",".join("null" if t is None else t for t in texts) + "]")
-    return [(type(empty)() if empty is not None else None) if v is None else v for v in values]
+    try:
+        values = json.loads("[" + ",".join("null" if t is None else t for t in texts) + "]")
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"the store is damaged: a stored value is not JSON ({exc})") from None
+    if len(values) != len(texts):      # a text such as '1, 2' would split into two values
+        raise ParameterError("the store is damaged: a stored value holds more than one JSON value")
+    out = [(type(empty)() if empty is not None else None) if v is None else v for v in values]
+    if isinstance(empty, dict) and any(not isinstance(v, dict) for v in out):
+        raise ParameterError("the store is damaged: a stored mapping (params or summary) is not a mapping")
+    return out
 
 
 def _mid(n: int) -> str:
