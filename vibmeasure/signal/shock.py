@@ -30,6 +30,9 @@ __all__ = ["srs", "ShockSpectrum", "srs_coefficients", "smallwood_coefficients",
 KINDS = ("maximax", "primary", "residual")
 OUTPUTS = ("acceleration", "pseudo_velocity", "relative_displacement")
 PTS_PER_CYCLE = 32   # an oscillator's response is sampled at least this finely (peak error < 0.5 %, then refined)
+# a sine's samples come within cos(pi / P) of its peak; the response is not one pure sine (damping, the
+# input changing within the step), so steps next to samples down to 90 % of that are searched too
+REACH_MARGIN = 0.9
 
 
 
@@ -162,7 +165,7 @@ def _between_samples(y, u, maps, per, lo, hi):
     best refined by a parabola (as an oscillator that is sampled finely enough)."""
     out = []
     seg = y[lo:hi]
-    reach = np.cos(np.pi / per) * 0.9
+    reach = np.cos(np.pi / per) * REACH_MARGIN
     for sign, best in ((1.0, float(seg.max())), (-1.0, -float(seg.min()))):
         # no signed copy of the record: compare the samples with the signed limit directly
         k = lo + np.flatnonzero(seg >= best * reach if sign > 0 else seg <= -best * reach)
