@@ -16,6 +16,7 @@ names is analysed once, with the manifest's metadata, even when it is also given
 from __future__ import annotations
 
 import os
+import re
 import time as _time
 from pathlib import Path
 
@@ -428,13 +429,17 @@ def _client(client, workers, scheduler):
     except ImportError:
         raise ParameterError("workers= and scheduler= need Dask: pip install 'vibmeasure[dask]'") from None
     if scheduler is not None:
+        # checked here: a Client that fails on a malformed address can hang in its own clean-up when
+        # another cluster runs in the process
+        m = re.fullmatch(r"(tcp|tls|ws|wss|ucx)://(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})/?", str(scheduler))
+        if m is None or not 0 < int(m.group(3)) < 65536:
+            raise ParameterError(f"scheduler={scheduler!r} is not a scheduler address; the form is tcp://HOST:PORT")
         try:
             return Client(scheduler, timeout=30), True
         except (OSError, TimeoutError) as exc:
             raise ParameterError(f"scheduler={scheduler!r}: no Dask scheduler answers there ({exc})") from None
         except (ValueError, TypeError) as exc:
-            raise ParameterError(f"scheduler={scheduler!r} is not a scheduler address ({exc}); the form is "
-                                 "tcp://HOST:PORT") from None
+            raise ParameterError(f"scheduler={scheduler!r} is not a scheduler address ({exc})") from None
     if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
         raise ParameterError(f"workers={workers!r} must be an integer >= 1")
     import dask
