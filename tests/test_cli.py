@@ -267,3 +267,13 @@ def test_model_help_documents_the_toml_format(capsys):
     text = capsys.readouterr().out
     for must in ('type = "sdof"', 'k = "40 N/mm"', "modal_zeta", "bc", "units:"):
         assert must in text
+
+
+@pytest.mark.parametrize("argv", [["ringdown", "missing.csv", "--json"], ["spectrum", "missing.wav", "--json"]])
+def test_json_errors_are_one_json_document(argv, tmp_path):
+    """With --json, stdout is always one JSON document: on an error {"error", "exit_code"} (issue 49)."""
+    import json
+    code, out, err = run([argv[0], str(tmp_path / argv[1])] + argv[2:])
+    assert code == 2 and "does not exist" in err
+    doc = json.loads(out)
+    assert doc["exit_code"] == 2 and "does not exist" in doc["error"]

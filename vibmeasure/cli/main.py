@@ -65,14 +65,21 @@ def main(argv=None, *, out=None, err=None) -> int:
     except BrokenPipeError:  # the reader of our output went away (| head)
         return 0
     except KeyboardInterrupt:   # Ctrl-C: said in one line; what a store committed before it stays
-        print("vibmeasure: interrupted", file=err)
-        return 130
+        return _failed(args, out, err, "interrupted", 130)
     except (VibMeasureError, OSError) as exc:
-        print(f"vibmeasure: error: {exc}", file=err)
-        return 2
+        return _failed(args, out, err, f"error: {exc}", 2)
     except Exception as exc:  # noqa: BLE001 - the last net: a defect, said as one
         if os.environ.get("VIBMEASURE_DEBUG"):
             raise
-        print(f"vibmeasure: error: unexpected {type(exc).__name__}: {exc}. This is a defect of vibmeasure; "
-              "please report it with the command (VIBMEASURE_DEBUG=1 shows the traceback)", file=err)
-        return 3
+        return _failed(args, out, err, f"error: unexpected {type(exc).__name__}: {exc}. This is a defect of "
+                       "vibmeasure; please report it with the command (VIBMEASURE_DEBUG=1 shows the traceback)", 3)
+
+
+def _failed(args, out, err, message: str, code: int) -> int:
+    """Say a failure in one line on stderr and, with --json, as the one JSON document on stdout too
+    (a script reading stdout always gets JSON: the results, or {"error": ..., "exit_code": ...})."""
+    print(f"vibmeasure: {message}", file=err)
+    if getattr(args, "json", False):
+        import json
+        print(json.dumps({"error": message.removeprefix("error: "), "exit_code": code}), file=out)
+    return code

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..core.errors import VibMeasureError
-from ._common import emit_json, plot_module, print_written, save_figure
+from ._common import emit_json, plot_module, print_warnings, print_written, quality_warnings, save_figure
 
 
 def register(sub) -> None:
@@ -46,8 +46,10 @@ def run(args, out, err) -> int:
         if not 0 < lo < hi:
             raise VibMeasureError(f"--fmin {lo:g} and --fmax {hi:g} must satisfy 0 < fmin < fmax")
         fn = lo * 2 ** (args.octave * np.arange(int(np.floor(np.log2(hi / lo) / args.octave)) + 1))
-    sp = srs(rec, fn=fn, zeta=args.zeta, Q=args.q, kind=args.kind, output=args.output, channel=args.channel,
-             octave=args.octave, pulse_end=args.pulse_end)
+    with quality_warnings() as msgs:   # said as vibmeasure's own lines, never a raw Python warning
+        sp = srs(rec, fn=fn, zeta=args.zeta, Q=args.q, kind=args.kind, output=args.output, channel=args.channel,
+                 octave=args.octave, pulse_end=args.pulse_end)
+    print_warnings(msgs, err)
     if args.csv:
         from ..io._common import write_table
         df = sp.to_frame()
@@ -61,7 +63,7 @@ def run(args, out, err) -> int:
         k0 = next(iter(sp.values))
         i = int(np.argmax(sp.values[k0]))
         print(f"{args.file}: channel {sp.channel}, input peak {sp.input_peak:.4g}, zeta {sp.zeta:g} "
-              f"(Q {1 / (2 * sp.zeta) if sp.zeta > 0 else float('inf'):.3g}); {sp.output} [{sp.unit}]", file=out)
+              f"(Q {1 / (2 * sp.zeta) if sp.zeta > 0 else float('inf'):.3g}); {sp.output} [{sp.unit or 'unit of the input, not stated'}]", file=out)
         print(f"  largest {k0}: {sp.values[k0][i]:.4g} {sp.unit} at {sp.fn[i]:.4g} Hz", file=out)
         print(f"  {'fn Hz':>10}  " + "  ".join(f"{k:>12}" for k in sp.values), file=out)
         for j in range(0, sp.fn.size, max(1, sp.fn.size // 24)):

@@ -200,7 +200,7 @@ def plot_srs(spec, *, ax=None, tripartite: bool | None = None):
     ax.set_xlabel("natural frequency [Hz]")
     q = f"Q {1 / (2 * spec.zeta):.3g}" if spec.zeta > 0 else "undamped"
     if tri:
-        ax.set_ylabel("pseudo-velocity [m/s]")
+        ax.set_ylabel("pseudo-velocity [m/s]" if spec.unit else "pseudo-velocity [input unit x s]")
         lo, hi = ax.get_ylim()
         f0, f1 = spec.fn[0], spec.fn[-1]
         for d in 10.0 ** np.arange(-9, 2):
@@ -212,7 +212,7 @@ def plot_srs(spec, *, ax=None, tripartite: bool | None = None):
                      "acceleration m/s^2)", fontsize=8)
     else:
         qty = {"acceleration": "peak acceleration", "relative_displacement": "peak relative displacement"}
-        ax.set_ylabel(f"{qty.get(spec.output, spec.output)} [{spec.unit}]")
+        ax.set_ylabel(f"{qty.get(spec.output, spec.output)} [{spec.unit or 'input unit, not stated'}]")
         ax.set_title(f"shock response spectrum of {spec.channel} ({q})", fontsize=9)
     ax.grid(True, which="both", lw=0.3)
     ax.legend(fontsize=8, loc="lower right")

@@ -291,12 +291,15 @@ def srs(rec, *, fn=None, zeta: float | None = None, Q: float | None = None, kind
     for k, fk in enumerate(f):
         prim[:, k], resid[:, k] = _oscillator(x_ext, x.size, B[k], A[k], fk, z, rec.fs, filt, tails[k], k_end)
     scale = np.ones_like(f)
+    known = bool(unit) and _units.quantity_of(unit) == "acceleration"
     out_unit = "m/s^2"
     if output == "pseudo_velocity":
         scale, out_unit = 2 * np.pi * f, "m/s"
     elif output == "relative_displacement":
         out_unit = "m"
-    elif unit and _units.quantity_of(unit) == "acceleration":
+    if not known:   # an input of unknown unit: the spectrum is in that unit (per s, s^2), not SI
+        out_unit = ""
+    elif output == "acceleration":
         scale = scale * _units.convert(1.0, "m/s^2", unit)
         out_unit = unit
     prim, resid = prim * scale, resid * scale
@@ -307,7 +310,7 @@ def srs(rec, *, fn=None, zeta: float | None = None, Q: float | None = None, kind
               "residual_negative": resid[1], "method": "ramp-invariant recursive filter (exact for a piecewise-linear input)",
               "points_per_cycle": PTS_PER_CYCLE, "q": 1 / (2 * z) if z > 0 else np.inf}
     peak_in = float(np.max(np.abs(x)))
-    if unit and _units.quantity_of(unit) == "acceleration":
+    if known:
         peak_in = float(_units.convert(peak_in, "m/s^2", unit))
     return ShockSpectrum(f, values, output, out_unit, z, rec.channels[idx].name, peak_in, rec.duration, extras)
 
