@@ -214,3 +214,12 @@ def test_residual_holds_both_extrema_at_high_damping(zeta):
         tol = 5e-3 * sp.values["residual"][k]
         assert sp.extras["residual_positive"][k] == pytest.approx(max(after.max(), 0.0), abs=tol), f
         assert sp.extras["residual_negative"][k] == pytest.approx(max(-after.min(), 0.0), abs=tol), f
+
+
+def test_an_input_of_unknown_unit_gives_a_spectrum_of_unknown_unit():
+    """Issue 49: the spectrum of an input whose unit nobody stated was labelled m/s^2."""
+    t = np.arange(2000) / 20000.0
+    pulse = np.where(t < 0.002, 50.0 * np.sin(np.pi * t / 0.002), 0.0)
+    sp = vm.srs(vm.Record.from_array(pulse, fs=20000.0), Q=10)
+    assert sp.unit == ""
+    assert vm.srs(vm.Record.from_array(pulse, fs=20000.0, unit="g"), Q=10).unit == "g"
