@@ -277,3 +277,11 @@ def test_json_errors_are_one_json_document(argv, tmp_path):
     assert code == 2 and "does not exist" in err
     doc = json.loads(out)
     assert doc["exit_code"] == 2 and "does not exist" in doc["error"]
+
+
+def test_report_exits_1_when_an_input_was_not_analysed(tmp_path):
+    """Issue 49: the report is written with the failed input's section, and the exit code says so."""
+    bad = tmp_path / "bad.csv"
+    bad.write_text("a,b\n")
+    code, _, err = run(["report", str(bad), "-o", str(tmp_path / "r.html")])
+    assert code == 1 and "1 of 1 input(s) not analysed" in err and (tmp_path / "r.html").is_file()

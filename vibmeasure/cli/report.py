@@ -30,9 +30,16 @@ def run(args, out, err) -> int:
 
 def _report(args, out, err) -> int:
     from ..reporting import report
+    failures: list = []
     path = report(args.inputs, args.out, store=args.store, title=args.title, rpm=args.rpm, bearing=args.bearing,
-                  band=tuple(args.band) if args.band else None, model=args.model)
+                  band=tuple(args.band) if args.band else None, model=args.model, failures=failures)
+    for name, message in failures:
+        print(f"vibmeasure: not analysed: {name}: {message}", file=err)
     print(f"vibmeasure: wrote {path}", file=err)
+    if failures:   # the report stands, but a script must see that inputs are missing from it
+        print(f"vibmeasure: {len(failures)} of {len(args.inputs) + (args.store is not None)} input(s) not analysed",
+              file=err)
+        return 1
     return 0
 
 def _demo(args, out, err) -> int:

@@ -67,7 +67,7 @@ def analyse_input(path, *, rpm=None, bearing=None, band=None, model=None):
 
 
 def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration measurement report", rpm=None,
-           bearing=None, band=None, model=None, summary=None) -> Path:
+           bearing=None, band=None, model=None, summary=None, failures: list | None = None) -> Path:
     """Write a self-contained HTML report of input files and, with ``store``, the fleet trends.
 
     Each input gets the section its content calls for (``core.dispatch.analysis_for``); a file that
@@ -93,6 +93,9 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
         A TOML model each estimate is compared with.
     summary : list of str, optional
         Lines for the report's summary.
+    failures : list, optional
+        When given, the name and error of each input (or the store) that could not be analysed is
+        appended to it as ``(name, message)``: the report is written all the same.
 
     Returns
     -------
@@ -133,6 +136,8 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
             prov.append(row)
         except Exception as exc:   # noqa: BLE001 - one input's failure is its section, never the report's
             sections.append(error_section(Path(str(p)).name, exc))
+            if failures is not None:
+                failures.append((str(p), f"{type(exc).__name__}: {str(exc)[:300]}"))
             prov.append({"input": Path(str(p)).name,
                          "sha256": file_sha256(p) if Path(str(p)).is_file() else "(missing)",
                          "method": "not analysed"})
@@ -143,6 +148,8 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
             prov.append({"input": name, "sha256": digest, "method": "trend"})
         except Exception as exc:   # noqa: BLE001 - the fleet's failure is its section, never the report's
             sections.append(error_section(str(store), exc))
+            if failures is not None:
+                failures.append((str(store), f"{type(exc).__name__}: {str(exc)[:300]}"))
     if not sections:
         raise ParameterError("nothing to report: give input files and/or a store")
     env = jinja2.Environment(loader=jinja2.PackageLoader("vibmeasure.reporting", "templates"),
