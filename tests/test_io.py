@@ -577,3 +577,12 @@ def test_a_mat_header_with_a_negative_dimension_is_named(tmp_path):
     p.write_bytes(bytes(raw))
     with pytest.raises(vm.ParameterError, match="dimension below 0"):
         vm.read(p)
+
+
+@pytest.mark.parametrize("col,fs", [("time_ms", 1000.0), ("t_us", 1e6), ("time_s", 1.0), ("Time", 1.0)])
+def test_a_time_column_with_its_unit_in_the_name(tmp_path, col, fs):
+    """Issue 49: a time_ms column was read as a channel."""
+    p = tmp_path / "t.csv"
+    p.write_text(f"{col},acc\n0,0.1\n1,0.2\n2,0.3\n3,0.1\n")
+    r = vm.read(p)
+    assert r.names == ["acc"] and r.fs == pytest.approx(fs)

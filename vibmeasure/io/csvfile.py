@@ -15,7 +15,6 @@ from ._common import (DEFAULT_MAX_SAMPLES, MAX_CHANNELS, atomic_path, check_size
                       parse_number, require_fs)
 
 _FS_KEYS = ("fs", "fs_hz", "sampling_rate", "sample_rate", "samplerate", "sampling_frequency")
-_TIME_NAMES = ("time", "t", "zeit", "seconds", "time_s", "timestamp")
 _NAME_UNIT = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]*)\s*[\])]\s*$")
 
 
@@ -135,7 +134,9 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
     _check_rows(values, has_header, header_kv, src)
     split = [_split_name_unit(lab) for lab in labels]
     names, units = [nm for nm, _ in split], [un for _, un in split]
-    tcol = next((i for i, n in enumerate(names) if n.lower() in _TIME_NAMES), None)
+    tcol, t_unit = _time_column(names)
+    if tcol is not None and t_unit and not units[tcol]:
+        units[tcol] = t_unit      # time_ms, t_us: the unit in the name
     fs, t0 = _timing(values, units, tcol, header_kv, fs, src)
     data_cols = [i for i in range(len(names)) if i != tcol]
     if not data_cols:
@@ -154,6 +155,18 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
         rec = rec.replace(channels=tuple(Channel(c.name, c.quantity, c.unit, locations.get(c.name, ""))
                                          for c in rec.channels))
     return rec
+
+
+_TIME_NAME = re.compile(r"^(time|t|zeit|seconds|timestamp)(?:[_ ]?(s|sec|ms|us))?$", re.I)
+
+
+def _time_column(names: list) -> tuple:
+    """(index, unit from the name) of the time column, e.g. "time", "t", "time_s", "time_ms"; else (None, None)."""
+    for i, n in enumerate(names):
+        m = _TIME_NAME.match(n.strip())
+        if m:
+            return i, {"sec": "s"}.get((m.group(2) or "").lower(), (m.group(2) or "").lower())
+    return None, None
 
 
 def _header_and_body(lines: list, src: str) -> tuple[dict, dict, list]:
