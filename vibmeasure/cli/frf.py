@@ -66,7 +66,9 @@ def run(args, out, err) -> int:
     if args.csv:
         _frf_csv(args.csv, frf, est)
     from ..core.results import jsonable
-    coh = None if frf.coherence is None else [float(np.mean(c)) for c in frf.coherence]
+    # one average (one hit) makes the coherence 1 at every line: it measures nothing, so none is given
+    one = frf.params.get("n_averages") == 1
+    coh = None if frf.coherence is None or one else [float(np.mean(c)) for c in frf.coherence]
     info = {"form": frf.form, "estimator": frf.estimator, "outputs": list(frf.outputs), "inputs": list(frf.inputs),
             "df_hz": frf.df, "n_lines": int(frf.freq.size), "n_averages": frf.params.get("n_averages"),
             "mean_coherence": coh, "exp_window_tau_s": frf.params.get("exp_window_tau_s"),
@@ -83,6 +85,8 @@ def run(args, out, err) -> int:
               f"{info['n_averages']} averages", file=out)
         if coh:
             print("mean coherence: " + ", ".join(f"{o} {c:.3f}" for o, c in zip(frf.outputs, coh)), file=out)
+        elif one and frf.coherence is not None:
+            print("coherence: not measured (one average: it is 1 by construction; average several hits)", file=out)
         if est is not None:
             print(f"{'mode':>4}  {'fn [Hz]':>12}  {'± std':>10}  {'zeta':>10}  {'± std':>9}  flags", file=out)
             for i in range(est.n_modes):
