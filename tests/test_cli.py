@@ -285,3 +285,14 @@ def test_report_exits_1_when_an_input_was_not_analysed(tmp_path):
     bad.write_text("a,b\n")
     code, _, err = run(["report", str(bad), "-o", str(tmp_path / "r.html")])
     assert code == 1 and "1 of 1 input(s) not analysed" in err and (tmp_path / "r.html").is_file()
+
+
+def test_spectrum_leaves_out_a_time_column_as_ringdown_does(tmp_path):
+    """Issue 49: a headerless two-column file (time, signal): `spectrum` analysed the time column too."""
+    t = np.arange(4096) / 1000.0
+    p = tmp_path / "two.csv"
+    np.savetxt(p, np.c_[t, np.sin(2 * np.pi * 50 * t)], delimiter=",")
+    code, out, err = run(["spectrum", str(p), "--fs", "1000", "--peaks", "1", "--json"])
+    import json
+    doc = json.loads(out)
+    assert code == 0 and doc["channels"] == ["ch1"] and "looks like a time column" in err.replace("look(s)", "looks")

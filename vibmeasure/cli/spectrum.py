@@ -58,6 +58,7 @@ def run(args, out, err) -> int:
 
 def _spectrum(args, out, err):
     from .. import io
+    from ..core._validate import time_like_channels
     from ..signal import demod
     from ..signal import peaks as pk
     from ..signal import spectral
@@ -73,6 +74,11 @@ def _spectrum(args, out, err):
     else:
         rec = io.read(p, fs=args.fs, unit=args.unit)
     chans = args.channel
+    ramps = time_like_channels(rec) if chans is None else []
+    if ramps and len(ramps) < rec.n_channels:   # the rule ringdown and diagnose follow: a time column is no signal
+        chans = [n for n in rec.names if n not in ramps]
+        print(f"vibmeasure: warning: {', '.join(repr(n) for n in ramps)} look(s) like a time column and is left out "
+              "(name it with --channel to analyse it)", file=err)
     bar = Progress(err, args.kind)
     try:
         if args.kind == "psd":

@@ -136,6 +136,15 @@ def _looks_like(x: np.ndarray) -> str | None:
     return None
 
 
+def time_like_channels(rec) -> list[str]:
+    """Names of the channels of unknown quantity that are a uniform increasing ramp: a time column read as
+    data (a headerless two-column file). The same rule ``response_channel`` passes them over by."""
+    if not hasattr(rec, "data"):
+        return []
+    return [c.name for c, x in zip(rec.channels, rec.data)
+            if c.quantity in ("unknown", "") and _looks_like(x) == "time"]
+
+
 def response_channel(rec: Record, channel) -> int:
     """The channel to analyse: the one named, the only one, or the first that is not a force. Channels
     of unknown quantity that look like a time column or a hammer pulse are passed over when another is
