@@ -391,3 +391,25 @@ def test_model_files_take_the_new_beams_and_refuse_truth_values(tmp_path):
     p.write_text('type = "sdof"\n[parameters]\nm = "1 kg"\nk = "1 N/m"\nzeta = ' + "9" * 4000 + "\n")
     with pytest.raises(vm.ParameterError, match="zeta"):
         M.load(p)
+
+
+def test_new_functions_name_their_bad_arguments():
+    """Found on the final read: each refused by name, none a raw numpy error or a silent NaN."""
+    t = np.arange(6000) / 1000.0
+    f = np.sin(2 * np.pi * 10 * t)
+    x = f.copy()
+    x[4000] = np.nan
+    rec = vm.Record(np.vstack([f, x]), 1000.0, channels=[vm.Channel("F", "force", "N"),
+                                                         vm.Channel("x", "displacement", "m")])
+    with pytest.raises(vm.ParameterError, match="output channel 'x' holds NaN"):
+        vm.stepped_sine(rec, [10.0, 20.0])
+    flat = vm.FRF(freq=np.linspace(1, 60, 600), h=np.ones(600) + 0j)
+    for band in ("ab", (1,), (50, 10)):
+        with pytest.raises(vm.ParameterError, match="band="):
+            vm.antiresonances(flat, band=band)
+    with pytest.raises(vm.ParameterError, match="nu='x' must be a number"):
+        M.TimoshenkoBeam(E=1.0, I=1.0, rho=1.0, A=1.0, L=1.0, nu="x")
+    with pytest.raises(vm.ParameterError, match=r"nu=0.7 must be in \(-1, 0.5\]"):
+        M.slenderness_limit(nu=0.7)
+    with pytest.raises(vm.ParameterError, match="stiffnesses='a' must be a number"):
+        M.chain([1.0], ["a"])

@@ -71,7 +71,14 @@ def antiresonances(frf: FRF, *, output=0, input=0, band=None, prominence_db: flo
     io, ii = _index(output, frf.outputs, frf.n_outputs, "output"), _index(input, frf.inputs, frf.n_inputs, "input")
     p = positive(prominence_db, "prominence_db")
     f = np.asarray(frf.freq, float)
-    sel = f > 0 if band is None else (f >= band[0]) & (f <= band[1]) & (f > 0)
+    if band is not None:
+        try:
+            lo, hi = (float(v) for v in band)
+        except (TypeError, ValueError):
+            raise ParameterError(f"band={band!r} must be two frequencies (lo, hi) in Hz") from None
+        if not (np.isfinite(lo) and np.isfinite(hi) and 0 <= lo < hi):
+            raise ParameterError(f"band={band!r} must satisfy 0 <= lo < hi (Hz)")
+    sel = f > 0 if band is None else (f >= lo) & (f <= hi) & (f > 0)
     if np.count_nonzero(sel) < 5:
         raise ParameterError(f"band={band!r} holds {np.count_nonzero(sel)} lines of the FRF; at least 5 are needed")
     f, h = f[sel], frf.h[io, ii][sel]

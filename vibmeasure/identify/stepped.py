@@ -80,6 +80,10 @@ def stepped_sine(rec, freqs, *, input="force", outputs=None, dwell: float | None
         raise ParameterError("stepped_sine takes one force channel: a tone excites through one input at a time")
     spans = _dwells(rec, freqs, dwell, settle)
     chans = [ii[0]] + oo
+    for o in oo:
+        if not np.all(np.isfinite(rec.data[o])):
+            raise ParameterError(f"output channel {rec.names[o]!r} holds NaN or inf samples: the rule is finite data "
+                                 "(repair or cut the record first)")
     fits = [_fit_tone(rec.data[chans][:, a:b], f, rec.fs) for f, (a, b) in zip(freqs, spans)]
     h, rel, thd, snr, halves = _ratios(fits)
     flags = _checks(freqs, rel, thd, snr, halves)

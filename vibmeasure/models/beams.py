@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
-from ..core._validate import positive
+from ..core._validate import finite_number, positive
 from ..core.errors import ParameterError
 from ._beam_solver import SectionModes, _Section
 from .continua import _CHAR, _est, _n
@@ -165,7 +165,7 @@ class TimoshenkoBeam(_BeamTheory):
     def __init__(self, *, E, I, rho, A, L, bc="cantilever", G=None, nu=0.3, kappa=5 / 6, zeta=0.0):
         self._common(E, I, rho, A, L, bc, zeta)
         if G is None:
-            nu = float(nu)
+            nu = finite_number(nu, "nu")
             if not -1 < nu <= 0.5:
                 raise ParameterError(f"nu={nu!r} must be in (-1, 0.5]")
             G = self.E / (2 * (1 + nu))
@@ -216,7 +216,10 @@ def slenderness_limit(bc: str = "cantilever", *, mode: int = 1, tolerance: float
     if theory not in ("timoshenko", "rayleigh"):
         raise ParameterError(f"theory={theory!r} must be 'timoshenko' or 'rayleigh'")
     mode = _n(mode)
-    e_kg = 2 * (1 + float(nu)) / positive(kappa, "kappa")      # E / (kappa G)
+    nu = finite_number(nu, "nu")
+    if not -1 < nu <= 0.5:
+        raise ParameterError(f"nu={nu!r} must be in (-1, 0.5]")
+    e_kg = 2 * (1 + nu) / positive(kappa, "kappa")      # E / (kappa G)
 
     def shortfall(log_sr):
         r2 = np.exp(-2 * log_sr)         # unit EI, rho A and L: r^2 = I / A

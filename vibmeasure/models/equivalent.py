@@ -290,13 +290,13 @@ def chain(masses, stiffnesses, *, dampers=None, modal_zeta=None):
     7.0831
     """
     from .mdof import MDOF
-    m = np.array([positive(v, "masses") for v in np.atleast_1d(np.asarray(masses, float))])
+    m = np.array([positive(v, "masses") for v in np.atleast_1d(np.asarray(masses, dtype=object)).ravel()])
     n = need = m.size
     if n < 1:
         raise ParameterError("masses must hold at least one mass")
 
     def assemble(values, name):
-        v = np.atleast_1d(np.asarray(values, float))
+        v = np.atleast_1d(np.asarray(values, dtype=object)).ravel()
         if v.size != need:
             raise ParameterError(f"{name} must hold {need} storey values for {n} masses, got {v.size}")
         v = np.array([positive(x, name, allow_zero=name == "dampers") for x in v])
