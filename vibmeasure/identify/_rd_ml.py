@@ -182,13 +182,14 @@ def _mode_energy(a, b, sig, t):
 
 def _colored_noise_scale(resid, w, fs, fd, bw, noise):
     """Per mode: sqrt(local residual PSD / white level) where it clearly exceeds 1, else 1."""
-    from scipy.signal import welch
+    from ._decay import _welch_linear
     n = int(w.sum())
     scale = np.ones(fd.size)
     if n < 256 or noise <= 0:
         return scale
     nper = int(min(4096, 2 ** int(np.log2(n // 8))))
-    f, pxx = welch(resid, fs=fs, nperseg=nper)
+    pxx = _welch_linear(resid, fs, nper, detrend="constant")
+    f = np.arange(pxx.size) * fs / nper
     white = 2 * noise ** 2 / fs
     df = f[1] - f[0]
     for k in range(fd.size):

@@ -10,6 +10,26 @@ from ..core.errors import FitError
 SUBSAMPLE = 100_000  # longer records are first fitted on every q-th sample, then polished in full
 
 
+def start_poles(x: np.ndarray, c0: int, fsr: float, max_modes: int, n_modes: int | None) -> np.ndarray:
+    """Start poles of a decay from sample ``c0`` on (after the last clipped one): ESPRIT's oscillating
+    poles, plus the spectrum's peaks ESPRIT missed. They see the oscillation without its offset and
+    drift (the fit models both): a drift of a few % of the peak took the subspace's leading
+    directions and lost a real beam's fundamental."""
+    from ._decay import detrend_linear
+    xs = detrend_linear(x[c0:])
+    try:
+        s = _esprit(xs, fsr, max_modes, n_modes)
+    except np.linalg.LinAlgError as exc:
+        raise FitError(f"subspace start values failed: {exc}") from None
+    osc = s[(s.imag > 2 * np.pi * fsr / x.size * 0.25) & (s.imag < np.pi * fsr * 0.999)]
+    spec = _spectral_candidates(xs, fsr, max_modes)
+    if spec.size:
+        res_w = 2 * np.pi * 10 * fsr / x.size  # ten bins of the unpadded spectrum: sidelobes
+        new = [c for c in spec if not osc.size or np.min(np.abs(osc.imag - c.imag)) > max(res_w, -c.real)]
+        osc = np.concatenate([osc, np.asarray(new, dtype=complex)])
+    return osc
+
+
 def _esprit(x: np.ndarray, fs: float, max_modes: int, n_modes: int | None):
     """Continuous-time poles s = -sigma + i w from a lagged-Hankel ESPRIT; also the eigenvalues."""
     n = x.size

@@ -25,14 +25,14 @@ from ..core._validate import as_record, check_band, check_memory, clean_signal, 
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.record import Record
 from ..core.results import FLAG_TEXT, ModalEstimate
-from ._decay import (alive_until, band_noise_std, clipped_mask, decay_start, decimation_factor, detrend_linear,
+from ._decay import (alive_until, band_noise_std, clipped_mask, decay_start, decimation_factor,
                      noise_std, trim_to_decay)
 from ._poles import pole_to_modal
 from ._rd_checks import (_add_backbone, _amplitude_check, _coulomb_check, _dominant_cycles, _nonlinear_damping,
                          _overdamped_try)
 from ._rd_ml import (_colored_noise_scale, _evaluate, _lm, _mode_energy, _mode_model, _mode_shares,  # noqa: F401
                      _pack, ringdown_crb)  # ringdown_crb: public here too
-from ._rd_start import SUBSAMPLE, _esprit, _linear_amplitudes, _spectral_candidates
+from ._rd_start import SUBSAMPLE, _linear_amplitudes, start_poles
 from .limits import MAX_REL_ZETA_STD
 
 __all__ = ["ringdown", "ringdown_crb"]
@@ -98,16 +98,37 @@ def ringdown(rec, *, channel=None, n_modes="auto", band=None, start: float | Non
     """
     try:
         return _ringdown(rec, channel, n_modes, band, start, max_modes, fs, progress)
+    except np.linalg.LinAlgError as exc:
+        raise _numerical_failure(exc) from None
+
+
+def _numerical_failure(exc) -> FitError:
+    return FitError(f"ringdown: the fit failed numerically ({exc}); the record may hold something the model "
+                    "of damped sinusoids plus offset and drift does not describe (a step, a saturation): "
+                    "give band= or start=, or cut the record")
+
+
+@single_threaded
+def linear_decay(rec, n_modes=1, poles=None) -> ModalEstimate:
+    """The ring-down estimator without its nonlinear checks (dry friction, amplitude-dependent damping,
+    backbone), for a decay that is linear by construction: EFDD's correlation function of a bell is an
+    average over amplitudes, where those checks have no meaning, and it is fitted a dozen times per
+    mode (bias steps, jackknife). The same fit, stds and mode flags as ``ringdown(rec, start=0)``;
+    ``extras["fitted_poles"]`` holds every fitted component's pole. ``poles`` (such a list from a fit
+    of a nearby decay, as a jackknife replicate's full-data fit) replaces the subspace and spectral
+    start values."""
+    try:
+        return _ringdown(rec, None, n_modes, None, 0.0, 8, None, None, linear=True, poles=poles)
     except np.linalg.LinAlgError as exc:   # a fit gone to NaN or singular: said as the fit's failure
-        raise FitError(f"ringdown: the fit failed numerically ({exc}); the record may hold something the model "
-                       "of damped sinusoids plus offset and drift does not describe (a step, a saturation): "
-                       "give band= or start=, or cut the record") from None
+        raise _numerical_failure(exc) from None
 
 
-def _ringdown(rec, channel, n_modes, band, start, max_modes, fs, progress) -> ModalEstimate:
-    """The ring-down pipeline, one line per step."""
+def _ringdown(rec, channel, n_modes, band, start, max_modes, fs, progress, linear=False,
+              poles=None) -> ModalEstimate:
+    """The ring-down pipeline, one line per step (``linear``: the nonlinear checks left out)."""
     d = _prepare(rec, channel, n_modes, band, start, max_modes, fs, progress)
-    special = _special_cases(d)          # dry friction is another model; amplitude dependence, one mode
+    d.linear, d.poles = linear, poles
+    special = None if linear else _special_cases(d)   # dry friction; amplitude dependence, one mode
     if special is not None:
         return special
     d.tick(0.15)
@@ -150,6 +171,8 @@ class _Decay:
     tn: np.ndarray | None = None
     nl_pre: dict = field(default_factory=dict)
     decimation: int = 1
+    linear: bool = False      # the nonlinear and over-damped alternatives left out (linear_decay)
+    poles: object = None      # given start poles (linear_decay of a replicate)
 
 
 @dataclass
@@ -260,19 +283,7 @@ def _start_values(d: _Decay) -> _Start | None:
     c0 = int(np.flatnonzero(d.clip)[-1]) + 1 if d.clip.any() else 0
     if x.size - c0 < 64:
         raise FitError(f"only {x.size - c0} samples follow the last clipped one: too few to fit a decay")
-    # the start values see the oscillation without its offset and drift (the fit models both): a drift
-    # of a few % of the peak took the subspace's leading directions and lost a real beam's fundamental
-    xs = detrend_linear(x[c0:])
-    try:
-        s = _esprit(xs, fsr, d.max_modes, d.n_modes)
-    except np.linalg.LinAlgError as exc:
-        raise FitError(f"subspace start values failed: {exc}") from None
-    osc = s[(s.imag > 2 * np.pi * fsr / x.size * 0.25) & (s.imag < np.pi * fsr * 0.999)]
-    spec = _spectral_candidates(xs, fsr, d.max_modes)
-    if spec.size:
-        res_w = 2 * np.pi * 10 * fsr / x.size  # ten bins of the unpadded spectrum: sidelobes
-        new = [c for c in spec if not osc.size or np.min(np.abs(osc.imag - c.imag)) > max(res_w, -c.real)]
-        osc = np.concatenate([osc, np.asarray(new, dtype=complex)])
+    osc = start_poles(x, c0, d.fsr, d.max_modes, d.n_modes) if d.poles is None else np.asarray(d.poles, complex)
     if not osc.size:
         return None
     sig0, om0 = np.maximum(-osc.real, 1e-6 * osc.imag), osc.imag
@@ -300,7 +311,7 @@ def _start_values(d: _Decay) -> _Start | None:
 
 
 def _nothing_oscillates(d: _Decay):
-    od = _overdamped_try(d.x_all[d.i0:], d.rec.fs, d.rec, d.idx, d.flags)
+    od = None if d.linear else _overdamped_try(d.x_all[d.i0:], d.rec.fs, d.rec, d.idx, d.flags)
     if od is not None:
         return od
     raise FitError("no decaying mode stands out of the noise (the record looks like noise)")
@@ -476,7 +487,7 @@ def _mode_flags(d: _Decay, f: _Fit, k: int, amp, fd) -> list:
 
 def _nothing_to_report(d: _Decay, f: _Fit, c: _Modes):
     """No mode to report: an over-damped decay, or a FitError that names why."""
-    od = _overdamped_try(d.x_all[d.i0:], d.rec.fs, d.rec, d.idx, d.flags)
+    od = None if d.linear else _overdamped_try(d.x_all[d.i0:], d.rec.fs, d.rec, d.idx, d.flags)
     if od is not None:
         return od
     if c.rejected:
@@ -516,10 +527,13 @@ def _assemble(d: _Decay, f: _Fit, c: _Modes) -> ModalEstimate:
     ik = np.asarray(c.report)
     fn_r, zeta_r = f.fn[ik].copy(), f.zeta[ik].copy()
     fn_std_r, zeta_std_r = f.fn_std[ik].copy(), f.zeta_std[ik].copy()
-    _nonlinear_checks(d, f, c, ik, extras, fn_r, zeta_r, zeta_std_r)
+    if d.linear:
+        extras["fitted_poles"] = (-f.sig + 1j * f.om).tolist()
+    else:
+        _nonlinear_checks(d, f, c, ik, extras, fn_r, zeta_r, zeta_std_r)
     resid_all = d.x - f.model
     tables = []
-    for j, k in enumerate(ik):  # every reported mode, isolated from the other reported modes
+    for j, k in enumerate([] if d.linear else ik):  # every reported mode, isolated from the other reported modes
         if np.isfinite(zeta_r[j]):
             # unreported components within 20 % of the mode are part of it: a chirping (nonlinear) decay
             # is fitted as a mode plus a close helper that takes up its frequency change

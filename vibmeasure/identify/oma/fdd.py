@@ -16,7 +16,7 @@ from ...core.record import Record
 from ...core.results import ModalEstimate
 from ..limits import MAX_REL_ZETA_STD
 from ..shapes import mac_pair, mpc
-from ._common import (MIN_CYCLES, N_GROUPS, _check_duration, _normalise, _outputs, band_kurtosis,
+from ._common import (MIN_CYCLES, N_GROUPS, OutputSpectra, _check_duration, _normalise, _outputs, band_kurtosis,
                       harmonic_by_kurtosis)
 
 __all__ = ["oma_fdd"]
@@ -169,7 +169,8 @@ def _efdd(bell, w, fs, nperseg, power=0):
         exact = np.zeros(bell.size)
         exact[k] = fk ** power / ((fn ** 2 - fk ** 2) ** 2 + (2 * z * fn * fk) ** 2)
         try:
-            sim, _ = _efdd_fit(exact, w, fs, nperseg)
+            wn = 2 * np.pi * fn
+            sim, _ = _efdd_fit(exact, w, fs, nperseg, poles=[complex(-z * wn, wn * np.sqrt(1 - z * z))])
         except (FitError, ParameterError):
             return est, end, None   # the exact bell's decay cannot be fitted: keep the fit, flagged
         step_f, step_z = fn0 - float(sim.fn[0]), z0 - float(sim.zeta[0])
@@ -181,10 +182,10 @@ def _efdd(bell, w, fs, nperseg, power=0):
     return dataclasses.replace(est, fn=np.array([fn]), zeta=np.array([z])), end, (fn0 - fn, z0 - z)
 
 
-def _efdd_fit(bell, w, fs, nperseg, end=None):
+def _efdd_fit(bell, w, fs, nperseg, end=None, poles=None):
     """Fit the bell's correlation function (a free decay) with the ring-down estimator, over ``end``
     samples (default: until its envelope falls to a tenth, or the window's own correlation to 0.3)."""
-    from ..ringdown import ringdown
+    from ..ringdown import linear_decay
     r = np.fft.irfft(bell)[:nperseg]
     wac = _window_autocorrelation(np.ascontiguousarray(w, float).tobytes())
     r = r / np.maximum(wac, 1e-12)
@@ -199,7 +200,7 @@ def _efdd_fit(bell, w, fs, nperseg, end=None):
     from ...core.errors import QualityWarning
     with warnings.catch_warnings():   # the ring-down's own findings stay in its flags, read by the caller
         warnings.simplefilter("ignore", QualityWarning)
-        est = ringdown(Record.from_array(r[:end] / r0, fs=fs, name="correlation"), n_modes=1, start=0.0)
+        est = linear_decay(Record.from_array(r[:end] / r0, fs=fs, name="correlation"), n_modes=1, poles=poles)
     return est, end
 
 
@@ -291,14 +292,15 @@ def oma_fdd(rec, *, band=None, nperseg: int | None = None, channels=None, n_mode
     f, G, w, n_seg, Gg = _csd_matrix(Y, rec.fs, nper)
     U, S, _ = np.linalg.svd(G)
     sel = (f >= band[0]) & (f <= band[1])
-    picked, rejected = _fdd_peaks(f, S, U, sel, float(min_prominence_db), rec.fs / nper, n_modes, Y, rec.fs)
+    picked, rejected = _fdd_peaks(f, S, U, sel, float(min_prominence_db), rec.fs / nper, n_modes, OutputSpectra(Y),
+                                  rec.fs)
     if not picked:
         raise FitError(f"oma_fdd: no peak in band={band} stands {min_prominence_db} dB out of the singular values "
                        f"as a resonance (rejected: {[(round(c['f'], 3), c['reason']) for c in rejected]})")
     return _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg, Gg)
 
 
-def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end):
+def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end, poles):
     """Leave-one-group-out EFDD of one mode (the segments in N_GROUPS groups): jackknife std of fn
     and zeta of the plain fit, or None when fewer than all but one replicate succeed. (The bell-cut
     bias correction shifts every replicate alike; the caller scales the std by its slope.) Every
@@ -309,14 +311,15 @@ def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end):
     tot = Gg[:, lo:hi].sum(axis=0)
     ref = U[c["line"], :, c["sv"]]
     vals = []
+    U_all, S_all, _ = np.linalg.svd(tot[None] - Gg[:, lo:hi])     # every replicate in one call
     for g in range(Gg.shape[0]):
-        Ur, Sr, _ = np.linalg.svd(tot - Gg[g, lo:hi])
+        Ur, Sr = U_all[g], S_all[g]
         k = int(np.argmax([mac_pair(Ur[c["line"] - lo, :, j], ref) for j in range(Sr.shape[1])]))
         sub, sub_lines = _bell(Sr, Ur, dict(c, line=c["line"] - lo, sv=k), mac_bell)
         bell = np.zeros(Gg.shape[1])
         bell[lo:hi] = sub
         try:
-            e, _ = _efdd_fit(bell, w, fs, nper, end)
+            e, _ = _efdd_fit(bell, w, fs, nper, end, poles)
             if np.isfinite(e.fn[0]) and np.isfinite(e.zeta[0]):
                 vals.append((e.fn[0], e.zeta[0]))
         except (FitError, ParameterError):
@@ -335,7 +338,8 @@ def _efdd_mode(c, bell, lines, U, Gg, w, fs, nper, mac_bell, power):
     fl, bias = [], None
     try:
         e, end, bias = _efdd(bell, w, fs, nper, power)
-        jk = _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end) if Gg is not None else None
+        jk = (_efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end, e.extras["fitted_poles"])
+              if Gg is not None else None)
         if bias is None:
             fl.append("bias_uncorrected")
         elif jk is not None:

@@ -12,7 +12,8 @@ from ...core.results import ModalEstimate
 from ..limits import MAX_REL_ZETA_STD
 from ..shapes import mac_pair, mpc, mpd
 from ._common import (CLUSTER_DF, CLUSTER_MAC, MAX_ZETA, MIN_CYCLES, MIN_MPC, STAB_DF, STAB_DZ, STAB_MAC, TONE_KURTOSIS,
-                      _check_duration, _normalise, _outputs, band_kurtosis, harmonic_by_kurtosis)
+                      OutputSpectra, _check_duration, _normalise, _outputs, band_kurtosis,
+                      harmonic_by_kurtosis)
 
 
 # --- SSI-cov ------------------------------------------------------------------------------------
@@ -48,13 +49,12 @@ def _covariances(Y, n_lags, n_blocks):
 
 
 def _toeplitz(R, s):
-    """Block Toeplitz matrix of R_1..R_(2s-1): block (i, j) = R_(s + i - j)."""
-    l = R.shape[1]
-    T = np.empty((s * l, s * l))
-    for i in range(s):
-        for j in range(s):
-            T[i * l:(i + 1) * l, j * l:(j + 1) * l] = R[s + i - j]
-    return T
+    """Block Toeplitz matrix of R_1..R_(2s-1): block (i, j) = R_(s + i - j); R is (2s+1, l, l), or a
+    stack (..., 2s+1, l, l) giving a stack of matrices."""
+    l = R.shape[-1]
+    i, j = np.indices((s, s))
+    blocks = R[..., s + i - j, :, :]                         # (..., s, s, l, l)
+    return np.swapaxes(blocks, -3, -2).reshape(R.shape[:-3] + (s * l, s * l))
 
 
 def _poles_at(U, sv, order, l, fs, O=None):
@@ -154,30 +154,55 @@ def _representative(c):
     return rep
 
 
-def _replicate(T, V, sv, l, fs, reps):
-    """One jackknife replicate: each mode's fn and zeta at every order of its cluster (NaN where the
-    replicate has no pole within CLUSTER_DF of the full data's pole at that order, with shape MAC >=
-    CLUSTER_MAC), shape (n_modes, n_orders, 2). A replicate is a small perturbation of the full data,
-    so each order's pole is matched to the full data's pole at the same order, not to the cluster."""
-    cache = {}
+def _replicate_poles(T, V, sv, l, fs, orders):
+    """Every replicate's poles at each order, all replicates at once: {order: (lam, phi, ok)} with lam
+    (n_b, order), phi (n_b, l, order) and ok marking the physical poles (|mu| < 1, Im > 0). A
+    replicate's observability matrix is taken on the full data's right singular vectors, T_b V_n
+    S_n^-1/2 (first-order equal to its own SVD's, without the order swaps of near-equal singular
+    values that make a re-computed SVD jump). One QR of the largest order's shifted rows serves every
+    order: the least-squares A_n = R_n^-1 (Q^T O_down)_n, since the first n columns of O_up are
+    Q_n R_n."""
+    O = T @ (V[:, :orders[-1]] / np.sqrt(sv[:orders[-1]]))          # (n_b, s l, n_max)
+    Q, Rq = np.linalg.qr(O[:, :-l])
+    M = np.swapaxes(Q, 1, 2) @ O[:, l:]
+    out = {}
+    for n in orders:
+        try:
+            A = np.linalg.solve(Rq[:, :n, :n], M[:, :n, :n])
+        except np.linalg.LinAlgError:    # a rank-deficient replicate: the slower least squares
+            A = np.array([np.linalg.lstsq(O[b, :-l, :n], O[b, l:, :n], rcond=None)[0] for b in range(O.shape[0])])
+        mu, psi = np.linalg.eig(A)
+        ok = (np.abs(mu) > 0) & (np.abs(mu) < 1) & (mu.imag > 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lam = np.where(ok, np.log(np.where(ok, mu, 0.5)) * fs, np.nan)
+        out[n] = (lam, O[:, :l, :n] @ psi, ok)
+    return out
+
+
+def _replicates(T, V, sv, l, fs, reps):
+    """Each replicate's fn and zeta of each mode at every order of its cluster: (n_b, n_modes, n_orders,
+    2), NaN where the replicate has no pole within CLUSTER_DF of the full data's pole at that order,
+    with shape MAC >= CLUSTER_MAC. A replicate is a small perturbation of the full data, so each
+    order's pole is matched to the full data's pole at the same order, not to the cluster."""
+    orders = sorted({n for rp in reps for n in rp["orders"]})
+    poles = _replicate_poles(T, V, sv, l, fs, orders)
+    n_b = T.shape[0]
     width = max(len(rp["orders"]) for rp in reps)
-    out = np.full((len(reps), width, 2), np.nan)
+    out = np.full((n_b, len(reps), width, 2), np.nan)
+    rows = np.arange(n_b)
     for m, rp in enumerate(reps):
+        ref = np.asarray(rp["phi"], complex)
         for a, n in enumerate(rp["orders"]):
-            if n not in cache:
-                # the replicate's observability matrix on the full data's right singular vectors:
-                # T_b V_n S_n^-1/2 (first-order equal to its own SVD's, without the order swaps of
-                # near-equal singular values that make a re-computed SVD jump)
-                cache[n] = _poles_at(None, None, n, l, fs, O=T @ V[:, :n] / np.sqrt(sv[:n]))
-            lam, phi = cache[n]
-            if not lam.size:
-                continue
+            lam, phi, ok = poles[n]
             lam0 = rp["lam_at"][n]
-            d = np.abs(lam - lam0) / abs(lam0)
-            k = int(np.argmin(d))
-            if d[k] <= CLUSTER_DF and mac_pair(phi[:, k], rp["phi"]) >= CLUSTER_MAC:
-                f, z = _modal(lam[k:k + 1])
-                out[m, a] = f[0], z[0]
+            d = np.where(ok, np.abs(lam - lam0) / abs(lam0), np.inf)
+            k = np.argmin(d, axis=1)
+            v = phi[rows, :, k]                                   # (n_b, l)
+            mac = np.abs(v.conj() @ ref) ** 2 / (np.sum(np.abs(v) ** 2, axis=1) * np.vdot(ref, ref).real)
+            hit = (d[rows, k] <= CLUSTER_DF) & (mac >= CLUSTER_MAC)
+            wn = np.abs(lam[rows, k])
+            out[hit, m, a, 0] = wn[hit] / (2 * np.pi)
+            out[hit, m, a, 1] = -lam[rows, k].real[hit] / wn[hit]
     return out
 
 
@@ -188,11 +213,8 @@ def _jackknife(S, cnt, s, l, fs, reps, V, sv):
     std follows from the replicates' estimates, NaN when more than 20 % of them lost the mode."""
     n_b = S.shape[0]
     tot, ctot = S.sum(axis=0), cnt.sum(axis=0)
-    vals = []
-    for b in range(n_b):
-        R = (tot - S[b]) / np.maximum(ctot - cnt[b], 1)[:, None, None]
-        vals.append(_replicate(_toeplitz(R, s), V, sv, l, fs, reps))
-    vals = np.array(vals)                       # (n_b, n_modes, n_orders, 2)
+    R = (tot[None] - S) / np.maximum(ctot[None] - cnt, 1)[:, :, None, None]
+    vals = _replicates(_toeplitz(R, s), V, sv, l, fs, reps)    # (n_b, n_modes, n_orders, 2)
     n_ord = np.array([len(rp["orders"]) for rp in reps])
     import warnings
     with np.errstate(invalid="ignore"), warnings.catch_warnings():
@@ -310,13 +332,14 @@ def oma_ssi(rec, *, band=None, max_order: int = 40, block_rows: int | None = Non
     reps = [_representative(c) for c in modes]
     fn_std, zeta_std = _jackknife(S, cnt, s, l, fs_d, reps, Vt.T, sv)
     hw = [max(3 * rp["zeta"] * rp["fn"], 10 * rec.fs / Y.shape[1]) for rp in reps]
-    kurt = [band_kurtosis(Y, rec.fs, rp["fn"], h, rp["phi"]) for rp, h in zip(reps, hw)]
+    spectra = OutputSpectra(Y)
+    kurt = [band_kurtosis(spectra, rec.fs, rp["fn"], h, rp["phi"]) for rp, h in zip(reps, hw)]
     tone = [harmonic_by_kurtosis(k, h, Y.shape[1] / rec.fs) for k, h in zip(kurt, hw)]
     keep, rejected = _screen(reps, fn_std, zeta_std, kurt, tone)
     if not keep:
         raise FitError(f"oma_ssi: no mode in band={band} that the data supports: "
                        + "; ".join(f"{d['fn_hz']:.5g} Hz: {d['reason']}" for d in rejected))
-    return _ssi_estimate(rec, Y, names, [modes[k] for k in keep], [reps[k] for k in keep], fn_std[keep],
+    return _ssi_estimate(rec, spectra, names, [modes[k] for k in keep], [reps[k] for k in keep], fn_std[keep],
                          zeta_std[keep], table, dict(
                              block_rows=s, orders=[orders[0], orders[-1]], n_blocks=n_blocks, decimation=q,
                              min_cluster=need, band_hz=list(band), rejected_modes=rejected))
@@ -362,7 +385,7 @@ def _ssi_sizes(max_order, block_rows, n_blocks, l):
     return list(range(2, max_order + 1, 2)), s, int(n_blocks)
 
 
-def _ssi_estimate(rec, Y, names, modes, reps, fn_std, zeta_std, table, info):
+def _ssi_estimate(rec, spectra, names, modes, reps, fn_std, zeta_std, table, info):
     fn = np.array([rp["fn"] for rp in reps])
     zeta = np.array([rp["zeta"] for rp in reps])
     lam = -zeta * 2 * np.pi * fn + 1j * 2 * np.pi * fn * np.sqrt(1 - zeta ** 2)
@@ -372,14 +395,14 @@ def _ssi_estimate(rec, Y, names, modes, reps, fn_std, zeta_std, table, info):
     flags = []
     for k in range(fn.size):
         fl = []
-        if fn[k] * Y.shape[1] / rec.fs < MIN_CYCLES:
+        if fn[k] * spectra.shape[1] / rec.fs < MIN_CYCLES:
             fl.append("few_cycles")
         near = [j for j in range(fn.size) if j != k and abs(fn[j] - fn[k]) < 3 * (zeta[j] * fn[j] + zeta[k] * fn[k])]
         if near:
             fl.append("close_modes")
         flags.append(tuple(fl))
-    f_psd, p_psd = _psd_overlay(Y, rec.fs)
-    near = [_tones_near(Y, rec.fs, f_psd, p_psd, fn[k], zeta[k], reps[k]["phi"]) for k in range(fn.size)]
+    f_psd, p_psd = _psd_overlay(spectra.Y, rec.fs)
+    near = [_tones_near(spectra, rec.fs, f_psd, p_psd, fn[k], zeta[k], reps[k]["phi"]) for k in range(fn.size)]
     for k, tones in enumerate(near):
         if tones:
             flags[k] = flags[k] + ("near_harmonic",)
