@@ -1,12 +1,14 @@
-"""Batch throughput: synthetic 1 s, 3-channel, 25.6 kHz machine records through spectrum+diagnose.
+"""Batch throughput: synthetic 3-channel, 25.6 kHz machine records through spectrum+diagnose.
 
 Runs, in one process: vm.batch serially, vm.batch on a local Dask cluster with 2 worker processes
 (127.0.0.1), and a naive loop an engineer might write (scipy.signal.welch per channel + a pandas
 row per record, no diagnosis). Prints records/s, the ratio 2 workers / serial (target >= 1.7x on 2
 cores) and the client's peak resident memory after each run (it must not grow with the number of
-records: results are committed and dropped as they arrive).
+records: results are committed and dropped as they arrive). The store is an SQLite database (the
+default engine), or the HDF5 file with ``--store h5``.
 
-    python benchmarks/batch.py [N]          (N records, default 1000; about 2 minutes per 1000 on 2 cores)
+    python benchmarks/batch.py [N] [--seconds S] [--store db|h5]
+        N records of S s (default 200 of 10 s: about 12 minutes on 2 cores; 1000 of 1 s about 5)
     python benchmarks/batch.py --memory N   (the serial batch only, the client's RSS every N/12 records)
 """
 
@@ -30,12 +32,12 @@ def rss_mb():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
-def make(folder: Path, n: int) -> Path:
+def make(folder: Path, n: int, seconds: float = 1.0) -> Path:
     rng = np.random.default_rng(0)
     lines = ["file,asset,point,rpm,bearing,time"]
     faults = ("none", "none", "none", "bearing_outer_race", "unbalance")
     for i in range(n):
-        chans = [vm.synth.machine(fault=faults[i % 5], rpm=1500.0, fs=25600.0, duration=1.0,
+        chans = [vm.synth.machine(fault=faults[i % 5], rpm=1500.0, fs=25600.0, duration=seconds,
                                   seed=int(rng.integers(1 << 31))).data[0] for _ in range(3)]
         rec = vm.Record(np.array(chans), 25600.0, [vm.Channel(c, "acceleration", "g") for c in ("DE", "FE", "BA")])
         vm.write(folder / f"r{i:05d}.h5", rec)
@@ -128,37 +130,48 @@ def memory(n):
         print(f"  slope over the second half {slope:+.2f} kB per record ({rise / 1024:+.1f} MB); target: bounded")
 
 
+def _options(argv):
+    import argparse
+    ap = argparse.ArgumentParser(description="vm.batch throughput, serial and on 2 Dask workers")
+    ap.add_argument("n", nargs="?", type=int, default=200)
+    ap.add_argument("--seconds", type=float, default=10.0)
+    ap.add_argument("--store", choices=("db", "h5"), default="db")
+    return ap.parse_args(argv)
+
+
 def main():
     if sys.argv[1:2] == ["--memory"]:
         return memory(int(sys.argv[2]) if len(sys.argv) > 2 else 3000)
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
+    opt = _options(sys.argv[1:])
+    n = opt.n
     warnings.simplefilter("ignore")
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
         t0 = time.perf_counter()
-        man = make(d, n)
-        print(f"{n} records (1 s, 3 channels, 25.6 kHz) written in {time.perf_counter() - t0:.0f} s; "
-              f"client RSS {rss_mb():.0f} MB")
+        man = make(d, n, opt.seconds)
+        print(f"{n} records ({opt.seconds:g} s, 3 channels, 25.6 kHz) written in {time.perf_counter() - t0:.0f} s; "
+              f"client RSS {rss_mb():.0f} MB; store: {'SQLite' if opt.store == 'db' else 'HDF5'}")
         t0 = time.perf_counter()
         naive(sorted(d.glob("r*.h5")))
         t_naive = time.perf_counter() - t0
         print(f"  naive loop (welch + pandas, no diagnosis) {n / t_naive:7.1f} records/s   RSS {rss_mb():.0f} MB")
         t0 = time.perf_counter()
         clock_s = Clock()
-        rep = vm.batch(task="spectrum+diagnose", store=d / "serial.h5", manifest=man, progress=clock_s)
+        rep = vm.batch(task="spectrum+diagnose", store=d / f"serial.{opt.store}", manifest=man, progress=clock_s)
         t_serial = time.perf_counter() - t0
         done = int((rep["status"] == "done").sum())
-        print(f"  vm.batch serial                            {n / t_serial:7.1f} records/s   RSS {rss_mb():.0f} MB"
+        print(f"  vm.batch serial                            {n / t_serial:7.2f} records/s   RSS {rss_mb():.0f} MB"
               f"   ({done} done)")
         t0 = time.perf_counter()
         clock_d = Clock()
-        rep = vm.batch(task="spectrum+diagnose", store=d / "dask.h5", manifest=man, workers=2, progress=clock_d)
+        rep = vm.batch(task="spectrum+diagnose", store=d / f"dask.{opt.store}", manifest=man, workers=2,
+                       progress=clock_d)
         t_dask = time.perf_counter() - t0
         done = int((rep["status"] == "done").sum())
-        print(f"  vm.batch, local Dask cluster, 2 workers    {n / t_dask:7.1f} records/s   RSS {rss_mb():.0f} MB"
+        print(f"  vm.batch, local Dask cluster, 2 workers    {n / t_dask:7.2f} records/s   RSS {rss_mb():.0f} MB"
               f"   ({done} done; cluster start-up included: {clock_d.first - t0:.1f} s to the first result)")
         print(f"  2 workers / serial: {t_serial / t_dask:.2f}x overall (target >= 1.7x on 2 cores); "
-              f"{clock_d.rate() / clock_s.rate():.2f}x once running ({clock_s.rate():.1f} and {clock_d.rate():.1f} "
+              f"{clock_d.rate() / clock_s.rate():.2f}x once running ({clock_s.rate():.2f} and {clock_d.rate():.2f} "
               "records/s from the 10th to the last result)")
         for name, c in (("serial", clock_s), ("2 workers", clock_d)):
             slope, rise = c.growth()

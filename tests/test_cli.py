@@ -296,3 +296,22 @@ def test_spectrum_leaves_out_a_time_column_as_ringdown_does(tmp_path):
     import json
     doc = json.loads(out)
     assert code == 0 and doc["channels"] == ["ch1"] and "looks like a time column" in err.replace("look(s)", "looks")
+
+
+def test_several_files_per_command_one_result_each(sample_dir, tmp_path):
+    """Several files (or a quoted glob) on one command: with --json one array, a document per file in the
+    order given (an error's document in its place), the worst exit code; each picture named after its file."""
+    beam, three = sample_dir / "ringdown_beam.csv", sample_dir / "ringdown_3modes.h5"
+    code, out, err = run(["ringdown", str(beam), str(tmp_path / "missing.csv"), str(three), "--json"])
+    docs = json.loads(out)
+    assert code == 2 and [d["file"] for d in docs] == [str(beam), str(tmp_path / "missing.csv"), str(three)]
+    assert docs[1]["exit_code"] == 2 and "does not exist" in docs[1]["error"]
+    single = json.loads(run(["ringdown", str(beam), "--json"])[1])
+    assert docs[0]["modes"] == single["modes"]   # the same result as run alone
+    for f in (beam, three):
+        shutil.copy(f, tmp_path / f.name)
+    code, out, err = run(["ringdown", str(tmp_path / "ringdown_*"), "--plot", str(tmp_path / "fit.png")])
+    assert code == 0 and out.count("== ") == 2
+    assert (tmp_path / "fit-ringdown_beam.png").is_file() and (tmp_path / "fit-ringdown_3modes.png").is_file()
+    code, _, err = run(["ringdown", str(tmp_path / "nothing_*.csv")])
+    assert code == 2 and "does not exist" in err

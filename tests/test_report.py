@@ -60,7 +60,8 @@ def test_the_demo_report_holds_every_section_with_its_numbers(demo_dir):
                   "Fleet trends: results.db", "Provenance"):
         assert title in text
     # the synthetic truths: beam 23.7 Hz / zeta 0.012; modes 31, 87, 165 Hz; outer-race fault; pump-3 alarm
-    assert re.search(r"fn 23\.7\d* Hz, zeta 0\.012", text)
+    m = re.search(r"fn (\d+\.\d+) Hz, zeta (0\.\d+)", text)     # each to the digits its std supports
+    assert abs(float(m[1]) - 23.7) < 0.005 and abs(float(m[2]) - 0.012) < 0.0005
     for f in ("31.0", "87.0", "165.0"):
         assert f in text.replace("30.99", "31.0").replace("86.99", "87.0")
     assert "bearing outer race" in text and "pump-3: alarm" in text
@@ -81,6 +82,38 @@ def test_a_report_of_each_kind_and_a_bad_file_listed(tmp_path):
     assert "Not analysed:" in text and "broken.h5" in text  # listed with its error, the rest reported
     assert re.search(r"fn (12|12\.0\d*|11\.9\d*) Hz", text)  # 12.0 Hz to the 5 digits shown
     assert "resolution_limited" in text and "What to do:" in text and "record longer (finer lines) or sample faster" in text
+
+
+SHARED = __import__("pathlib").Path(__file__).resolve().parents[2] / "shared" / "data"
+
+
+def test_a_report_of_records_and_of_files_that_need_their_options(tmp_path):
+    """The options a real file needs: the hammer test's force channel (--input) makes it FRFs and modes,
+    not a ring-down; fs for a file without timing; channels chosen; a vm.Record reported as it is."""
+    hammer = SHARED / "impact" / "case1.mat"
+    assert hammer.is_file(), "../shared/data/impact/case1.mat is a development recording the tests read"
+    out = vm.report([hammer], tmp_path / "h.html", input="Time_chan_1")
+    _, _, text = _parse(out)
+    assert "FRF and modes: case1.mat" in text and "Ring-down" not in text
+    # a CSV of bare numbers (no time column) needs fs; a two-channel record reported on one channel
+    rec = vm.synth.free_decay(fn=12.0, zeta=0.02, fs=200.0, duration=6.0, snr_db=40, seed=2)
+    np.savetxt(tmp_path / "bare.csv", rec.data[0])
+    failures = []
+    vm.report([tmp_path / "bare.csv"], tmp_path / "b.html", failures=failures)
+    assert failures and "fs" in failures[0][1]                     # without fs: named as the missing option
+    out = vm.report([tmp_path / "bare.csv"], tmp_path / "b.html", fs=200.0)
+    assert re.search(r"fn (12|12\.0\d*|11\.9\d*) Hz", _parse(out)[2])
+    two = vm.Record(np.vstack([rec.data[0], np.random.default_rng(1).normal(size=rec.n_samples)]), fs=200.0,
+                    channels=["beam", "noise"], meta={"source": "beam test"})
+    out = vm.report(two, tmp_path / "c.html", channels=["beam"])
+    _, _, text = _parse(out)
+    assert "Ring-down: beam test" in text and "channel beam" in text
+    with pytest.raises(vm.ParameterError, match="fs= and unit= apply to files"):
+        from vibmeasure.core.dispatch import load_input
+        load_input(two, fs=100.0)
+    failures = []
+    vm.report([two], tmp_path / "d.html", input="hammer", failures=failures)
+    assert "is not in this record" in failures[0][1]
 
 
 def test_an_empty_store_and_bad_output_paths(tmp_path):
@@ -106,22 +139,41 @@ def _chromium():
     pytest.skip("no Chromium on this machine (outside CI): the browser test needs Debian's chromium package")
 
 
-def test_the_demo_report_renders_in_a_real_browser(demo_dir, tmp_path):
-    d, _ = demo_dir
-    browser = _chromium()
-    url = (d / "report.html").resolve().as_uri()
+def _dom(browser, url, width, height):
     common = [browser, "--headless=new", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
-              "--window-size=412,915", "--virtual-time-budget=5000", "--enable-logging=stderr", "--v=0"]
+              f"--window-size={width},{height}", "--virtual-time-budget=5000", "--enable-logging=stderr", "--v=0"]
     dom = subprocess.run(common + ["--dump-dom", url], capture_output=True, text=True, timeout=120)
     assert dom.returncode == 0, dom.stderr[-2000:]
-    n_fig = int(re.search(r'data-figures="(\d+)"', dom.stdout).group(1))
-    n_ok = int(re.search(r'data-figures-rendered="(\d+)"', dom.stdout).group(1))
-    assert n_fig >= 8 and n_ok == n_fig  # every picture has a size on a phone-wide page
-    assert "fn 23.7" in dom.stdout and "bearing outer race" in dom.stdout
-    console = [l for l in dom.stderr.splitlines() if "CONSOLE" in l or "Uncaught" in l]
-    assert not console, console  # no console errors (a script error, a resource refused)
+    return common, dom
+
+
+def _attr(html, name):
+    return re.search(rf'{name}="([^"]*)"', html).group(1)
+
+
+def test_the_demo_report_renders_in_a_real_browser(demo_dir, tmp_path):
+    """The demo and a report of real recordings (a CWRU diagnosis, a hammer test) in headless Chromium at a
+    desktop (1280 px) and a phone (390 px) width: every picture rendered, no console error, and no table,
+    figure or paragraph wider than the page (the page measures itself: getBoundingClientRect against the
+    body's content box, scrollWidth against clientWidth)."""
+    d, _ = demo_dir
+    browser = _chromium()
+    real = vm.report([SHARED / "cwru" / "IR007_0.mat", SHARED / "impact" / "case1.mat"], tmp_path / "real.html")
+    hammer = vm.report([SHARED / "impact" / "case1.mat"], tmp_path / "hammer.html", input="Time_chan_1")
+    for page, min_fig in ((d / "report.html", 8), (real, 2), (hammer, 2)):
+        url = page.resolve().as_uri()
+        for width, height in ((1280, 900), (390, 844)):
+            common, dom = _dom(browser, url, width, height)
+            n_fig, n_ok = int(_attr(dom.stdout, "data-figures")), int(_attr(dom.stdout, "data-figures-rendered"))
+            assert n_fig >= min_fig and n_ok == n_fig, (page.name, width)   # every picture has a size
+            assert _attr(dom.stdout, "data-overflow") == "0", (page.name, width, _attr(dom.stdout, "data-overflow-what"))
+            console = [l for l in dom.stderr.splitlines() if "CONSOLE" in l or "Uncaught" in l]
+            assert not console, console  # no console errors (a script error, a resource refused)
+    common, dom = _dom(browser, (d / "report.html").resolve().as_uri(), 390, 844)
+    assert re.search(r"fn 23\.(7|69\d*)", dom.stdout) and "bearing outer race" in dom.stdout
     shot = tmp_path / "report.png"
-    r = subprocess.run(common + [f"--screenshot={shot}", url], capture_output=True, text=True, timeout=120)
+    r = subprocess.run(common + [f"--screenshot={shot}", (d / "report.html").resolve().as_uri()],
+                       capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and shot.stat().st_size > 20_000
 
 

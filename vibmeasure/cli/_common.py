@@ -45,6 +45,23 @@ def print_written(args, err, what=("csv", "plot")) -> None:
             print(f"vibmeasure: wrote {getattr(args, name)}", file=err)
 
 
+def add_files(parser, what: str) -> None:
+    """The command's input files: one or several (a quoted glob is expanded by ``main``), one result
+    each; the command's own ``run`` sees one file at a time."""
+    parser.add_argument("file", nargs="+", help=f"{what} (several files, or a quoted glob: one result each)")
+
+
+MODE_HEADER = f"{'mode':>4}  {'fn [Hz]':>14}  {'± std':>10}  {'zeta':>10}  {'± std':>9}"
+
+
+def mode_row(i, fn, fn_std, zeta, zeta_std, flags=(), extra="") -> str:
+    """One mode as a table row, each value rounded to its std by the one rule (core.rounding)."""
+    from ..core.rounding import with_std
+    f, fs = with_std(fn, fn_std)
+    z, zs = with_std(zeta, zeta_std)
+    return f"{i + 1:>4}  {f:>14}  {fs:>10}  {z:>10}  {zs:>9}  {extra}{','.join(flags)}"
+
+
 def emit_json(doc: dict, out, *, allow_nan: bool = False) -> None:
     """The command's one JSON document on stdout (NaN refused: JSON has none, ``jsonable`` maps it)."""
     json.dump(doc, out, indent=2, allow_nan=allow_nan)

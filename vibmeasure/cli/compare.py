@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..core.errors import VibMeasureError
-from ._common import emit_json, plot_module, print_warnings, quality_warnings, save_figure
+from ._common import add_files, emit_json, plot_module, print_warnings, quality_warnings, save_figure
 from .frf import get_frf
 from .model import predict
 
@@ -14,7 +14,7 @@ def register(sub) -> None:
                         description="Identify the record (ring-down by default; FRF + fit_modes with --input) "
                                     "and compare with a model (--model) or a healthy baseline history (--baseline). "
                                     "Exit status: 0 ok or watch, 1 alarm, 2 bad input, 3 a defect of vibmeasure.")
-    cp.add_argument("file", help="measurement record")
+    add_files(cp, "measurement record")
     ref = cp.add_mutually_exclusive_group(required=True)
     ref.add_argument("--model", help="model.toml")
     ref.add_argument("--baseline", help="baseline history (.h5 written by vm.History.save)")

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..core.errors import VibMeasureError
-from ._common import emit_json, plot_module, print_warnings, print_written, quality_warnings, save_figure
+from ._common import add_files, emit_json, plot_module, print_warnings, print_written, quality_warnings, save_figure
 
 
 def register(sub) -> None:
@@ -11,7 +11,7 @@ def register(sub) -> None:
     dg = sub.add_parser("diagnose", help="machine fault diagnosis from a vibration record",
                         description="Fault frequencies, envelope analysis, evidence per fault family and "
                                     "ISO 10816-3 severity.")
-    dg.add_argument("file", help="acceleration record")
+    add_files(dg, "acceleration record")
     dg.add_argument("--rpm", type=float, help="declared shaft speed (default: the file's rpm variable)")
     g = dg.add_mutually_exclusive_group()
     g.add_argument("--bearing", help="catalogue bearing: 6205-2RS, 6203-2RS (CWRU), MFPT, ZA-2115 (IMS), UER204 "

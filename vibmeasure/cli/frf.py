@@ -5,7 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..core.errors import VibMeasureError
-from ._common import emit_json, plot_module, print_warnings, print_written, quality_warnings, save_figure
+from ._common import (MODE_HEADER, add_files, emit_json, mode_row, plot_module, print_warnings, print_written,
+                      quality_warnings, save_figure)
 
 
 def register(sub) -> None:
@@ -14,7 +15,7 @@ def register(sub) -> None:
                            ("modes", "natural frequencies, damping and shapes from FRFs (fit_modes)")):
         q = sub.add_parser(name, help=helptext, description=helptext + "; FILE may hold time data or FRFs "
                                                                     "(UFF 58 function type 4).")
-        q.add_argument("file", help="record (.csv .h5 .wav .mat .lvm .uff) or FRF file (.uff)")
+        add_files(q, "record (.csv .h5 .wav .mat .lvm .uff) or FRF file (.uff)")
         q.add_argument("--input", default="force", help="input (force) channel name (default: the force channel)")
         q.add_argument("--output", action="append", help="output channel(s) (default: all others)")
         q.add_argument("--estimator", choices=("H1", "H2", "Hv"), default="H1",
@@ -88,11 +89,10 @@ def run(args, out, err) -> int:
         elif one and frf.coherence is not None:
             print("coherence: not measured (one average: it is 1 by construction; average several hits)", file=out)
         if est is not None:
-            print(f"{'mode':>4}  {'fn [Hz]':>12}  {'± std':>10}  {'zeta':>10}  {'± std':>9}  flags", file=out)
+            print(f"{MODE_HEADER}  flags", file=out)
             for i in range(est.n_modes):
                 m = est.mode(i)
-                print(f"{i + 1:>4}  {m['fn_hz']:12.6g}  {m['fn_std_hz']:10.2g}  {m['zeta']:10.5g}  "
-                      f"{m['zeta_std']:9.2g}  {','.join(m['flags'])}", file=out)
+                print(mode_row(i, m["fn_hz"], m["fn_std_hz"], m["zeta"], m["zeta_std"], m["flags"]), file=out)
     print_warnings(msgs, err)
     print_written(args, err)
     return 0
@@ -109,12 +109,8 @@ def get_frf(args):
     if args.input not in rec.names and args.input != "force":
         raise VibMeasureError(f"--input {args.input!r} is not in the file; channels are {rec.names}")
     if args.input in rec.names:
-        import dataclasses
-        i = rec.index(args.input)
-        chans = list(rec.channels)
-        if chans[i].quantity != "force":
-            chans[i] = dataclasses.replace(chans[i], quantity="force", unit="")
-            rec = rec.replace(channels=tuple(chans), note=f"channel {args.input!r} marked as force")
+        from ..core.dispatch import mark_force
+        rec = mark_force(rec, args.input)
     rec = _label_channels(rec, getattr(args, "quantity", None), getattr(args, "unit", None), args.input)
     if args.impact:
         return F.impact_frf(rec, input=args.input, outputs=args.output, estimator=args.estimator)

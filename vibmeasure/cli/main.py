@@ -60,6 +60,63 @@ def main(argv=None, *, out=None, err=None) -> int:
     err = err or sys.stderr
     _writes_fail_not_kill()
     args = build_parser().parse_args(argv)
+    if isinstance(getattr(args, "file", None), list):
+        return _each_file(args, _expand(args.file), out, err)
+    return _run(args, out, err)
+
+
+def _expand(files) -> list:
+    """The files as given, a quoted glob (one the shell did not expand: Windows, a script) expanded in
+    sorted order; a pattern that matches nothing stays, and its command says the file does not exist."""
+    import glob
+    out = []
+    for f in files:
+        hits = sorted(glob.glob(f)) if any(c in f for c in "*?[") and not os.path.exists(f) else []
+        out += hits or [f]
+    return out
+
+
+def _each_file(args, files, out, err) -> int:
+    """The command on each file in turn, as if run once per file: with --json one array of their
+    documents (an error's document in its place), in the order given; a file's pictures and tables
+    are named FILE-STEM inserted before the ending; the exit code is the worst of them (Ctrl-C stops)."""
+    import copy
+    import io
+    import json
+    from pathlib import Path
+    if len(files) == 1:
+        args.file = files[0]
+        return _run(args, out, err)
+    codes, docs = [], []
+    for f in files:
+        a = copy.copy(args)
+        a.file = f
+        for opt in ("plot", "csv"):
+            if getattr(args, opt, None):
+                p = Path(getattr(args, opt))
+                setattr(a, opt, str(p.with_name(f"{p.stem}-{Path(f).stem}{p.suffix}")))
+        if args.json:
+            buf = io.StringIO()
+            code = _run(a, buf, err)
+            try:
+                doc = json.loads(buf.getvalue())
+            except ValueError:
+                doc = {"error": "the command printed no JSON document", "exit_code": code}
+            docs.append({"file": f, **doc} if isinstance(doc, dict) else {"file": f, "result": doc})
+        else:
+            print(f"== {f}", file=out)
+            code = _run(a, out, err)
+        codes.append(code)
+        if code == 130:
+            break
+    if args.json:
+        json.dump(docs, out, indent=2)
+        out.write("\n")
+    return max(codes)
+
+
+def _run(args, out, err) -> int:
+    """One command on one input, every failure turned into its line and exit code."""
     try:
         return COMMANDS[args.command].run(args, out, err)
     except BrokenPipeError:  # the reader of our output went away (| head)

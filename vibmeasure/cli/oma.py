@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from ._common import emit_json, plot_module, print_warnings, quality_warnings, save_figure
+from ._common import (MODE_HEADER, add_files, emit_json, mode_row, plot_module, print_warnings, quality_warnings,
+                      save_figure)
 
 
 def register(sub) -> None:
@@ -10,7 +11,7 @@ def register(sub) -> None:
     om = sub.add_parser("oma", help="output-only modal analysis (SSI-cov or FDD) of ambient responses",
                         description="Natural frequencies, damping (with std) and shapes from responses to ambient "
                                     "or operating excitation: covariance-driven SSI (default) or FDD/EFDD.")
-    om.add_argument("file", help="record of the responses: .csv .h5 .wav .mat .lvm .uff")
+    add_files(om, "record of the responses: .csv .h5 .wav .mat .lvm .uff")
     om.add_argument("--method", choices=("ssi", "fdd", "both"), default="ssi",
                     help="ssi: covariance-driven stochastic subspace identification (default); fdd: frequency-"
                          "domain decomposition with EFDD damping; both: SSI's modes, each checked against FDD "
@@ -52,10 +53,10 @@ def run(args, out, err) -> int:
     else:
         print(f"{args.file}: {est.method}, {rec.n_channels} outputs, {est.n_modes} mode(s)"
               f" ({est.extras.get('std_method', '')})", file=out)
-        print(f"{'mode':>4}  {'fn Hz':>12}  {'fn std':>10}  {'zeta':>10}  {'zeta std':>9}  {'MPC':>5}  flags", file=out)
+        print(f"{MODE_HEADER}  {'MPC':>5}  flags", file=out)
         for i in range(est.n_modes):
-            print(f"{i + 1:>4}  {est.fn[i]:12.6g}  {est.fn_std[i]:10.2g}  {est.zeta[i]:10.5g}  {est.zeta_std[i]:9.2g}  "
-                  f"{est.extras['mpc'][i]:5.3f}  {','.join(est.mode_flags[i])}", file=out)
+            print(mode_row(i, est.fn[i], est.fn_std[i], est.zeta[i], est.zeta_std[i], est.mode_flags[i],
+                           f"{est.extras['mpc'][i]:5.3f}  "), file=out)
         for r in rejected:
             f0 = r.get("fn_hz", r.get("f"))
             print(f"  not a mode: {f0:.6g} Hz: {r['reason']}", file=out)

@@ -16,6 +16,12 @@ def register(sub) -> None:
     rp.add_argument("inputs", nargs="*", help="records (.csv .h5 .wav .mat .lvm)")
     rp.add_argument("-o", "--out", default="report.html", help="output HTML (default report.html)")
     rp.add_argument("--store", help="a vm.Store: its fleet trends are reported too")
+    rp.add_argument("--fs", type=float, help="sampling rate in Hz of files that carry no timing")
+    rp.add_argument("--unit", help="unit of the data when the files do not say (e.g. g)")
+    rp.add_argument("--channel", action="append", help="channel to analyse; repeat to name several (default every "
+                                                       "channel)")
+    rp.add_argument("--input", metavar="CHANNEL", help="force channel of a hammer or shaker test: reported as FRFs "
+                                                       "and modes")
     rp.add_argument("--rpm", type=float, help="shaft speed: records are diagnosed as machines")
     rp.add_argument("--bearing", help="catalogue bearing for the diagnosis")
     rp.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"), help="band for ringdown / fit_modes (Hz)")
@@ -32,7 +38,8 @@ def _report(args, out, err) -> int:
     from ..reporting import report
     failures: list = []
     path = report(args.inputs, args.out, store=args.store, title=args.title, rpm=args.rpm, bearing=args.bearing,
-                  band=tuple(args.band) if args.band else None, model=args.model, failures=failures)
+                  band=tuple(args.band) if args.band else None, model=args.model, failures=failures, fs=args.fs,
+                  unit=args.unit, channels=args.channel, input=args.input)
     for name, message in failures:
         print(f"vibmeasure: not analysed: {name}: {message}", file=err)
     print(f"vibmeasure: wrote {path}", file=err)

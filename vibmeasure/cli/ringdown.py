@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from ..core.errors import VibMeasureError
 from ..core.results import FLAG_TEXT
-from ._common import Progress, emit_json, plot_module, print_warnings, print_written, quality_warnings, save_figure
+from ._common import (MODE_HEADER, add_files, emit_json, mode_row, plot_module, print_warnings, print_written,
+                      Progress, quality_warnings, save_figure)
 
 _METHODS = ("ml", "logdec", "hilbert", "halfpower")
 
@@ -13,7 +14,7 @@ def register(sub) -> None:
     """Add the command's parser to the subparsers ``sub``."""
     r = sub.add_parser("ringdown", help="natural frequency and damping from a free decay",
                        description="Identify fn and zeta (with standard deviations) from a ring-down record.")
-    r.add_argument("file", help="record: .csv .h5 .wav .mat .lvm")
+    add_files(r, "record: .csv .h5 .wav .mat .lvm")
     r.add_argument("--channel", help="response channel name (default: the first that is not a force)")
     r.add_argument("--force", metavar="NAME",
                    help="channel holding the hammer/shaker force: the decay is fitted after its pulse")
@@ -50,11 +51,8 @@ def _ringdown(args, out, err=None):
     from ..identify import ringdown as rd
     rec = io.read(args.file, fs=args.fs, unit=args.unit, quantity=args.quantity)
     if args.force:
-        import dataclasses
-        i = rec.index(args.force)
-        chans = list(rec.channels)
-        chans[i] = dataclasses.replace(chans[i], quantity="force", unit="")
-        rec = rec.replace(channels=tuple(chans), note=f"channel {args.force!r} marked as force")
+        from ..core.dispatch import mark_force
+        rec = mark_force(rec, args.force)
     modes = args.modes
     if modes != "auto":
         try:
@@ -87,13 +85,10 @@ def _save_plot(path, rec, est):
 def _report_text(args, rec, est, out):
     ch = est.extras.get("channel", "")
     print(f"{args.file}  channel {ch}  fs {rec.fs:g} Hz  method {est.method}", file=out)
-    print(f"{'mode':>4}  {'fn [Hz]':>12}  {'± std':>10}  {'zeta':>10}  {'± std':>9}  flags", file=out)
+    print(f"{MODE_HEADER}  flags", file=out)
     for i in range(est.n_modes):
         m = est.mode(i)
-        def f(v, fmt):
-            return format(v, fmt) if v is not None else "n/a"
-        print(f"{i + 1:>4}  {f(m['fn_hz'], '12.6g')}  {f(m['fn_std_hz'], '10.2g')}  {f(m['zeta'], '10.5g')}  "
-              f"{f(m['zeta_std'], '9.2g')}  {','.join(m['flags'])}", file=out)
+        print(mode_row(i, m["fn_hz"], m["fn_std_hz"], m["zeta"], m["zeta_std"], m["flags"]), file=out)
     if "friction_decay_per_cycle" in est.extras:
         print(f"Coulomb friction: amplitude falls {est.extras['friction_decay_per_cycle']:.4g} {est.unit} per cycle",
               file=out)

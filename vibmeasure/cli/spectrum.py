@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..core.errors import VibMeasureError
-from ._common import Progress, emit_json, plot_module, print_written, save_figure
+from ._common import (add_files, emit_json, plot_module, print_written, Progress, save_figure)
 
 
 def register(sub) -> None:
@@ -13,7 +13,7 @@ def register(sub) -> None:
     sp = sub.add_parser("spectrum", help="amplitude spectrum, PSD or envelope spectrum with peaks",
                         description="Amplitude-correct spectrum, Welch PSD or squared-envelope spectrum of a "
                                     "record; HDF5 records are streamed from disk.")
-    sp.add_argument("file", help="record: .csv .h5 .wav .mat .lvm")
+    add_files(sp, "record: .csv .h5 .wav .mat .lvm")
     sp.add_argument("--kind", choices=("amplitude", "psd", "envelope"), default="amplitude",
                     help="amplitude: peak (or rms) amplitude per line in the channel unit; psd: Welch power spectral "
                          "density (unit^2/Hz); envelope: squared-envelope spectrum after a band-pass (--band), for "
@@ -104,7 +104,7 @@ def _spectrum_outputs(args, spec, found, band):
             df = df[(df.freq_hz >= band[0]) & (df.freq_hz <= band[1])]
         write_table(df, args.csv, {c: spec.unit for c in spec.channels})
     if args.plot:
-        ax = plot_module().plot_spectrum(spec, peaks=found[0] if found else None)
+        ax = plot_module().plot_spectrum(spec, peaks=found or None)   # every channel's, in its colour
         if band:
             ax.set_xlim(*band)
         save_figure(ax.figure, args.plot)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..core.errors import VibMeasureError
-from ._common import emit_json, plot_module, print_warnings, print_written, quality_warnings, save_figure
+from ._common import add_files, emit_json, plot_module, print_warnings, print_written, quality_warnings, save_figure
 
 
 def register(sub) -> None:
@@ -11,7 +11,7 @@ def register(sub) -> None:
     sr = sub.add_parser("srs", help="shock response spectrum of a base acceleration record",
                         description="Shock response spectrum (maximax, primary, residual) by the ramp-invariant "
                                     "recursive filter (Smallwood); 1/12-octave natural frequencies by default.")
-    sr.add_argument("file", help="record of the base acceleration: .csv .h5 .wav .mat .lvm .uff")
+    add_files(sr, "record of the base acceleration: .csv .h5 .wav .mat .lvm .uff")
     sr.add_argument("--channel", help="acceleration channel (default: the first that is not a force)")
     sr.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
     sr.add_argument("--unit", help="unit of the acceleration when the file does not say (g, m/s^2)")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.labels import label
 from ._style import _styled
 
 
@@ -122,6 +123,8 @@ def plot_diagnosis(rec, diag, *, axes=None):
     ax_g.set_xlim(-0.5, 0.6)
     ax_g.set_ylim(0, top)
     ax_g.set_xticks([])
+    ax_g.yaxis.tick_right()                  # the label beside its own scale, clear of the plots on the left
+    ax_g.yaxis.set_label_position("right")
     ax_g.set_ylabel("velocity RMS [mm/s]")
     return axes
 
@@ -196,8 +199,9 @@ def _plot_kurtogram(ax, kg, band):
     """Fast kurtogram (levels x frequency) with the band the evidence came from outlined."""
     img = kg.image("kurtosis")
     ax.grid(False)  # no grid lines across an image
-    ax.imshow(img, aspect="auto", origin="upper", cmap="viridis", interpolation="nearest",
-              extent=(0, kg.fs / 2, len(kg.levels) - 0.5, -0.5))
+    im = ax.imshow(img, aspect="auto", origin="upper", cmap="viridis", interpolation="nearest",
+                   extent=(0, kg.fs / 2, len(kg.levels) - 0.5, -0.5))
+    ax.figure.colorbar(im, ax=ax, pad=0.01, fraction=0.04, label="spectral kurtosis")
     ax.set_yticks(range(len(kg.levels)), [f"{lv:g}" for lv in kg.levels])
     ax.set_ylabel("level")
     ax.set_xlabel("frequency [Hz]")
@@ -264,7 +268,7 @@ def plot_trend(store, *, asset: str, point: str, metric: str, task: str | None =
     df, r = metric_history(store, asset=asset, point=point, metric=metric, task=task, baseline_count=baseline_count)
     if ax is None:
         _, ax = plt.subplots(figsize=(8, 3.5))
-    ax.plot(df["time"], df[metric].astype(float), "o-", ms=3, lw=1, color="C0", label=metric)
+    ax.plot(df["time"], df[metric].astype(float), "o-", ms=3, lw=1, color="C0", label=label(metric))
     if r is not None:
         mu, sd = r["baseline_mean"], r["baseline_std"]
         t_b = df["time"].iloc[:baseline_count]
@@ -272,9 +276,9 @@ def plot_trend(store, *, asset: str, point: str, metric: str, task: str | None =
         ax.axvspan(t_b.iloc[0], t_b.iloc[-1], color="0.93", zorder=0)
         ax.axhline(r["watch_limit"], color="orange", ls="--", lw=1, label="watch")
         ax.axhline(r["alarm_limit"], color="red", ls="--", lw=1, label="alarm")
-        ax.set_title(f"{asset}/{point}: {metric} - {r['verdict']}", fontsize=10)
+        ax.set_title(f"{asset}/{point}: {label(metric)} - {r['verdict']}", fontsize=10)
     ax.set_xlabel("time")
-    ax.set_ylabel(metric)
+    ax.set_ylabel(label(metric))
     ax.legend(fontsize=8, loc="best")
     ax.figure.autofmt_xdate()
     return ax

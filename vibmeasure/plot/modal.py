@@ -207,7 +207,8 @@ def plot_stabilisation(est, *, frf=None, ax=None):
         ax2.set_ylabel(f"mean PSD [{p['unit']}]")
     if band:
         ax.set_xlim(band[0], band[1])  # the fitted band, not the whole FRF
-    ax.legend(loc="upper left", fontsize=8)
+    # the legend under the axes, in one row: inside, it covered the poles of the lowest modes
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=6, fontsize=8, frameon=False)
     ax.set_title("stabilisation diagram (red: chosen modes)", fontsize=9)
     return ax
 

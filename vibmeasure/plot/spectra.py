@@ -25,8 +25,8 @@ def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: b
         Where to draw.
     channel : str or int, optional
         One channel (default all).
-    peaks : Peaks, optional
-        Picked peaks to mark and label.
+    peaks : Peaks or list of Peaks, optional
+        Picked peaks to mark and label, each channel's in its line's colour.
     lines : dict, optional
         Label -> frequency in Hz (e.g. {"BPFO": 107.4}).
     log : bool, optional
@@ -79,8 +79,10 @@ def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: b
         if not db:
             return v
         return (10 if power else 20) * np.log10(np.maximum(v, 1e-300))
+    colour = {}
     for i in rows:
-        ax.plot(spec.freq, scaled(spec.values[i]), lw=0.7, label=spec.channels[i])
+        (ln,) = ax.plot(spec.freq, scaled(spec.values[i]), lw=0.7, label=spec.channels[i])
+        colour[spec.channels[i]] = ln.get_color()
     top = fmax if fmax is not None else _content_end(spec, rows)
     ax.set_xlim(spec.freq[0], min(top, spec.freq[-1]))
     if not db and (log if log is not None else power):
@@ -89,10 +91,7 @@ def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: b
         vis = (spec.freq > 0) & (spec.freq <= top)
         peak = max(float(np.max(scaled(spec.values[i][vis]))) for i in rows) if vis.any() else 0.0
         ax.set_ylim(bottom=peak - (100 if power else 80), top=peak + 6)
-    if peaks is not None and len(peaks):
-        ax.plot(peaks.freq, scaled(peaks.amplitude), "v", color=COLORS["mode"], ms=5, label="peaks")
-        _label_without_collisions(ax, peaks.freq[:10], scaled(peaks.amplitude[:10]),
-                                  [f"{f:.4g}" for f in peaks.freq[:10]])
+    _mark_peaks(ax, peaks, scaled, colour)
     for label, f in (lines or {}).items():
         ax.axvline(f, color="0.5", lw=0.6, ls="--")
         ax.text(f, 1.0, f" {label}", transform=ax.get_xaxis_transform(), rotation=90, va="top",
@@ -125,9 +124,30 @@ def _content_end(spec, rows) -> float:
     return float(f[-1]) if last >= 0.95 * f[-1] else min(float(f[-1]), 1.05 * last)
 
 
-def _label_without_collisions(ax, xs, ys, texts, *, size: float = ANNOTATION_SIZE):
+def _mark_peaks(ax, peaks, scaled, colour):
+    """Each channel's peaks (a Peaks or a list of them, one per channel) in its line's colour, the ten
+    strongest of each labelled with their frequency in that colour."""
+    from ..core.results import Peaks
+    plist = [peaks] if isinstance(peaks, Peaks) else [p for p in (peaks or []) if p is not None]
+    xs, ys, texts, cols = [], [], [], []
+    for pk in plist:
+        if not len(pk):
+            continue
+        c = colour.get(pk.channel, COLORS["mode"])
+        ax.plot(pk.freq, scaled(pk.amplitude), "v", color=c, ms=5,
+                label="peaks" if len(plist) == 1 else f"peaks {pk.channel}")
+        xs += list(pk.freq[:10])
+        ys += list(scaled(pk.amplitude[:10]))
+        texts += [f"{f:.4g}" for f in pk.freq[:10]]
+        cols += [c] * min(10, len(pk))
+    if xs:
+        _label_without_collisions(ax, np.array(xs), np.array(ys), texts, colors=cols)
+
+
+def _label_without_collisions(ax, xs, ys, texts, *, size: float = ANNOTATION_SIZE, colors=None):
     """Label points (strongest first) just above them, each where it overlaps no label placed
-    before; a label that fits nowhere near its point is left out."""
+    before; a label lifted above its first place gets a leader line to its point, and a label that
+    fits nowhere near its point is left out."""
     ax.autoscale_view()
     to_px = ax.transData.transform
     pt = ax.figure.dpi / 72.0
@@ -138,7 +158,10 @@ def _label_without_collisions(ax, xs, ys, texts, *, size: float = ANNOTATION_SIZ
         for dy in (4.0, 4.0 + 1.4 * size, 4.0 + 2.8 * size):
             box = (px + 2 * pt, px + 2 * pt + w, py + dy * pt, py + dy * pt + h)
             if not any(box[0] < b[1] and b[0] < box[1] and box[2] < b[3] and b[2] < box[3] for b in placed):
-                ax.annotate(texts[k], (xs[k], ys[k]), textcoords="offset points", xytext=(2, dy), fontsize=size)
+                lead = {"arrowprops": {"arrowstyle": "-", "lw": 0.5, "color": "0.4", "shrinkA": 0, "shrinkB": 2}} \
+                    if dy > 4.0 else {}
+                ax.annotate(texts[k], (xs[k], ys[k]), textcoords="offset points", xytext=(2, dy), fontsize=size,
+                            color=colors[k] if colors is not None else "black", **lead)
                 placed.append(box)
                 break
 

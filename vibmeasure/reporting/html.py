@@ -16,23 +16,27 @@ from .sections import (comparison_section, diagnosis_section, error_section, fle
 
 
 # --- analysing an input by what it holds ----------------------------------------------------------
-def analyse_input(path, *, rpm=None, bearing=None, band=None, model=None):
-    """Sections for one file, by what it holds (``core.dispatch.analysis_for``): an FRF/modes section
-    when it has a force channel, a diagnosis when a shaft speed is known (``rpm`` or the file's rpm),
-    else a ring-down; plus a comparison when a model (TOML) is given. Returns (sections, provenance row)."""
+def analyse_input(item, *, rpm=None, bearing=None, band=None, model=None, fs=None, unit=None, channels=None,
+                  input=None):
+    """Sections for one file or record, by what it holds (``core.dispatch.analysis_for``, after
+    ``core.dispatch.load_input`` applied ``fs``, ``unit``, ``channels`` and the force channel
+    ``input``): an FRF/modes section when it has a force channel, a diagnosis when a shaft speed is
+    known (``rpm`` or the file's rpm), else a ring-down; plus a comparison when a model (TOML) is
+    given. Returns (sections, provenance row)."""
     import warnings
 
-    from .. import io
+    from ..core.dispatch import load_input
     from ..identify.frf import estimate_frf, impact_frf
     from ..identify.modal import fit_modes
     from ..identify.ringdown import ringdown
     from ..monitor.compare import compare
     from ..monitor.diagnosis import diagnose
-    name = Path(path).name
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        rec = io.read(path)
+        rec, name = load_input(item, fs=fs, unit=unit, channels=channels, input=input)
         forces = [c.name for c in rec.channels if c.quantity == "force"]
+        if input is not None:   # the named input first: a record may hold other force channels
+            forces.insert(0, rec.channels[rec.index(input)].name)
         speed = rpm if rpm is not None else rec.meta.get("rpm")
         secs, method = [], ""
         kind = analysis_for(rec, rpm=rpm)
@@ -63,20 +67,30 @@ def analyse_input(path, *, rpm=None, bearing=None, band=None, model=None):
                 method += f"; compare with {Path(model).name}"
             except (VibMeasureError, OSError, ValueError) as exc:
                 secs.append(error_section(f"comparison {what}", exc))
-    return secs, {"input": name, "sha256": file_sha256(path), "method": method}
+    return secs, {"input": name, "sha256": _sha(item), "method": method}
+
+
+def _sha(item) -> str:
+    """The provenance hash: a file's SHA-256, or a record's samples' (a record has no file)."""
+    from ..core.record import Record
+    if isinstance(item, Record):
+        import hashlib
+        return hashlib.sha256(np.ascontiguousarray(item.data).tobytes()).hexdigest()
+    return file_sha256(item) if Path(str(item)).is_file() else "(missing)"
 
 
 def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration measurement report", rpm=None,
-           bearing=None, band=None, model=None, summary=None, failures: list | None = None) -> Path:
-    """Write a self-contained HTML report of input files and, with ``store``, the fleet trends.
+           bearing=None, band=None, model=None, summary=None, failures: list | None = None, fs=None, unit=None,
+           channels=None, input=None) -> Path:
+    """Write a self-contained HTML report of records and, with ``store``, the fleet trends.
 
-    Each input gets the section its content calls for (``core.dispatch.analysis_for``); a file that
+    Each input gets the section its content calls for (``core.dispatch.analysis_for``); an input that
     cannot be analysed is listed with its error and the others are still reported. Written atomically.
 
     Parameters
     ----------
-    inputs : sequence of str or os.PathLike
-        Record files.
+    inputs : sequence of str, os.PathLike or Record
+        Record files and/or records (a single one is taken as a list of one).
     out : str or os.PathLike
         The HTML file.
     store : str, os.PathLike or Store, optional
@@ -96,6 +110,14 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
     failures : list, optional
         When given, the name and error of each input (or the store) that could not be analysed is
         appended to it as ``(name, message)``: the report is written all the same.
+    fs : float, optional
+        Sampling rate of files that carry no timing (a CSV without a time column, a WAV-less array).
+    unit : str, optional
+        Unit of the data of files that do not say (e.g. "g").
+    channels : str or sequence of str, optional
+        The channels analysed (default every channel).
+    input : str, optional
+        The force channel of a hammer or shaker test: the record is reported as FRFs and modes.
 
     Returns
     -------
@@ -125,22 +147,23 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
     out = Path(out)
     if not out.parent.exists():
         raise ParameterError(f"out={str(out)!r}: folder {str(out.parent)!r} does not exist")
-    if isinstance(inputs, (str, Path)):
+    from ..core.record import Record
+    if isinstance(inputs, (str, Path, Record)):
         inputs = [inputs]
     file_backend()
     sections, prov = [], []
     for p in inputs:
+        label = str(p.meta.get("source") or "record") if isinstance(p, Record) else Path(str(p)).name
         try:
-            secs, row = analyse_input(p, rpm=rpm, bearing=bearing, band=band, model=model)
+            secs, row = analyse_input(p, rpm=rpm, bearing=bearing, band=band, model=model, fs=fs, unit=unit,
+                                      channels=channels, input=input)
             sections += secs
             prov.append(row)
         except Exception as exc:   # noqa: BLE001 - one input's failure is its section, never the report's
-            sections.append(error_section(Path(str(p)).name, exc))
+            sections.append(error_section(label, exc))
             if failures is not None:
-                failures.append((str(p), f"{type(exc).__name__}: {str(exc)[:300]}"))
-            prov.append({"input": Path(str(p)).name,
-                         "sha256": file_sha256(p) if Path(str(p)).is_file() else "(missing)",
-                         "method": "not analysed"})
+                failures.append((label if isinstance(p, Record) else str(p), f"{type(exc).__name__}: {str(exc)[:300]}"))
+            prov.append({"input": label, "sha256": _sha(p), "method": "not analysed"})
     if store is not None:
         try:
             name, digest = _store_provenance(store)

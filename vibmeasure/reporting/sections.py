@@ -8,6 +8,8 @@ import io as _io
 import numpy as np
 
 from ..core.results import FLAG_TEXT
+from ..core.labels import label
+from ..core.rounding import band, plain, with_std
 
 FLAG_ADVICE = {
     "few_cycles": "record a longer decay, or excite harder so more cycles stand above the noise",
@@ -54,11 +56,14 @@ def _svg(fig) -> str:
 def _fmt(v, digits=5):
     if v is None:
         return ""
-    if isinstance(v, (float, np.floating)):
-        if not np.isfinite(v):
-            return "n/a"
-        return f"{v:.{digits}g}"
+    if isinstance(v, (float, np.floating, int, np.integer)) and not isinstance(v, bool):
+        return plain(v, digits)
     return str(v)
+
+
+def _pm(value, std) -> list:
+    """A value and its std as two cells, rounded by the one rule (core.rounding.with_std)."""
+    return list(with_std(value, std))
 
 
 def _flags(flags) -> list[dict]:
@@ -75,7 +80,7 @@ def _flags(flags) -> list[dict]:
 def _mode_table(est, caption):
     rows = []
     for i in range(est.n_modes):
-        rows.append([i + 1, _fmt(est.fn[i], 7), _fmt(est.fn_std[i], 2), _fmt(est.zeta[i], 4), _fmt(est.zeta_std[i], 2),
+        rows.append([i + 1, *_pm(est.fn[i], est.fn_std[i]), *_pm(est.zeta[i], est.zeta_std[i]),
                      ", ".join(est.mode_flags[i]) if est.mode_flags else ""])
     return {"caption": caption, "header": ["mode", "fn [Hz]", "± std", "zeta [-]", "± std", "flags"], "rows": rows}
 
@@ -88,7 +93,8 @@ def ringdown_section(rec, est, name):
                                                                                        "damping (maximum likelihood)")],
            "flags": _flags(list(est.flags) + mf), "figures": []}
     k = int(np.argmax(est.amplitude)) if est.amplitude is not None and est.n_modes else 0
-    sec["verdict"], sec["verdict_class"] = f"fn {est.fn[k]:.5g} Hz, zeta {est.zeta[k]:.4g}", "ok"
+    fn_k, zeta_k = with_std(est.fn[k], est.fn_std[k])[0], with_std(est.zeta[k], est.zeta_std[k])[0]
+    sec["verdict"], sec["verdict_class"] = f"fn {fn_k} Hz, zeta {zeta_k}", "ok"
     sec["verdict_text"] = f"(strongest of {est.n_modes} mode(s); channel {est.extras.get('channel', '')})"
     ax, _ = plot.plot_ringdown(rec, est)
     sec["figures"].append({"svg": _svg(ax.figure), "caption": "record, fitted decay and envelope; residual below"})
@@ -98,8 +104,8 @@ def ringdown_section(rec, est, name):
         b = b.iloc[np.unique(np.linspace(0, len(b) - 1, min(len(b), 12)).round().astype(int))]  # 12 rows at most
         sec["tables"].append({"caption": f"Backbone of the {est.fn[k]:.4g} Hz mode (fn and zeta versus amplitude)",
                               "header": ["amplitude", "fn [Hz]", "± std", "zeta", "± std"],
-                              "rows": [[_fmt(r.amplitude, 4), _fmt(r.fn_hz, 6), _fmt(r.fn_std_hz, 2), _fmt(r.zeta, 4),
-                                        _fmt(r.zeta_std, 2)] for r in b.itertuples()]})
+                              "rows": [[_fmt(r.amplitude, 4), *_pm(r.fn_hz, r.fn_std_hz), *_pm(r.zeta, r.zeta_std)]
+                                       for r in b.itertuples()]})
         axes = plot.plot_backbone(est, mode=k)
         sec["figures"].append({"svg": _svg(axes[0].figure), "caption": "damping and frequency versus amplitude"})
     return sec
@@ -117,7 +123,7 @@ def modes_section(frf, est, name):
                               "header": ["fn [Hz]", "zeta", "reason"],
                               "rows": [[_fmt(d["fn_hz"], 6), _fmt(d["zeta"], 3), d["reason"]] for d in rej]})
     sec["verdict"], sec["verdict_class"] = f"{est.n_modes} mode(s)", "ok"
-    sec["verdict_text"] = "in " + "-".join(f"{b:g}" for b in est.extras.get("band_hz", [])) + " Hz"
+    sec["verdict_text"] = "in " + band(*est.extras["band_hz"]) + " Hz" if est.extras.get("band_hz") else ""
     axes = plot.plot_frf(frf, est=est)
     sec["figures"].append({"svg": _svg(axes[0].figure), "caption": "FRF magnitude, phase and coherence with the "
                                                                    "modal synthesis"})
@@ -137,11 +143,11 @@ def diagnosis_section(rec, diag, name):
         cls = "alarm" if diag.confidence >= 0.9 else "watch"
     sec = {"kind": "diagnosis", "title": f"Machine diagnosis: {name}", "tables": [], "figures": [],
            "flags": _flags([f for f in diag.flags if f in FLAG_ADVICE]),
-           "verdict": diag.top.replace("_", " "), "verdict_class": cls,
+           "verdict": label(diag.top), "verdict_class": cls,
            "verdict_text": f"(confidence {diag.confidence:.2f}) {diag.reason}"}
     rows = []
     for r in diag.faults.to_dict(orient="records"):
-        rows.append([r.get("fault"), _fmt(r.get("expected_hz"), 5), _fmt(r.get("found_hz"), 5),
+        rows.append([label(r.get("fault")), _fmt(r.get("expected_hz"), 5), _fmt(r.get("found_hz"), 5),
                      _fmt(r.get("evidence_db"), 3), _fmt(r.get("confidence"), 2), _fmt(r.get("log10_p"), 3),
                      r.get("note") or ""])
     sec["tables"].append({"caption": "Evidence per fault family", "header": ["fault", "expected [Hz]", "found [Hz]",
@@ -149,8 +155,8 @@ def diagnosis_section(rec, diag, name):
                                                                             "log10 p", "note"], "rows": rows})
     sec["tables"].append({"caption": "ISO 10816-3 severity", "header": ["velocity RMS [mm/s]", "band [Hz]", "group",
                                                                        "foundation", "zone"],
-                          "rows": [[_fmt(sev.get("velocity_rms_mm_s"), 3), "-".join(_fmt(b) for b in
-                                                                                   sev.get("band_hz", [])),
+                          "rows": [[_fmt(sev.get("velocity_rms_mm_s"), 3),
+                                    band(*sev["band_hz"]) if sev.get("band_hz") else "",
                                     sev.get("group"), sev.get("foundation"), sev.get("zone")]]})
     axes = plot.plot_diagnosis(rec, diag)
     sec["figures"].append({"svg": _svg(np.ravel(axes)[0].figure), "caption": "spectrum, envelope spectrum with the "
@@ -184,12 +190,13 @@ def fleet_section(store, name):
     sec["tables"].append({"caption": "Verdict per asset, point and metric", "header": ["asset", "point", "metric",
                                                                                        "baseline", "last", "alarm limit",
                                                                                        "verdict", "reason"],
-                          "rows": [[r.asset, r.point, r.metric, _fmt(r.baseline_mean, 4), _fmt(r.last, 4),
+                          "rows": [[r.asset, r.point, label(r.metric), with_std(r.baseline_mean, r.baseline_std)[0]
+                                    if np.isfinite(r.baseline_std) else _fmt(r.baseline_mean, 4), _fmt(r.last, 4),
                                     _fmt(r.alarm_limit, 4), r.verdict, r.reason] for r in tr.itertuples()]})
     # the trended metrics (a baseline to draw against) that are not ok
     for r in tr[(tr["verdict"] != "ok") & tr["baseline_mean"].notna()].head(4).itertuples():
         ax = plot.plot_trend(store, asset=r.asset, point=r.point, metric=r.metric, task=r.task)
-        sec["figures"].append({"svg": _svg(ax.figure), "caption": f"{r.asset}/{r.point}: {r.metric}"})
+        sec["figures"].append({"svg": _svg(ax.figure), "caption": f"{r.asset}/{r.point}: {label(r.metric)}"})
     return sec
 
 

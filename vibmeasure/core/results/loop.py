@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
-import numpy as np
 
 from ._common import jsonable
 
@@ -87,7 +86,9 @@ class LoopDamping:
         return jsonable(d)
 
     def __repr__(self) -> str:
-        std = "" if not np.isfinite(self.loss_factor_std) else f" +- {self.loss_factor_std:.2g}"
-        return (f"LoopDamping(W={self.energy_per_cycle:.4g} J per cycle, eta={self.loss_factor:.4g}{std}, "
+        from ..rounding import with_std
+        eta, eta_std = with_std(self.loss_factor, self.loss_factor_std, digits=4)
+        std = "" if eta_std == "n/a" else f" +- {eta_std}"
+        return (f"LoopDamping(W={self.energy_per_cycle:.4g} J per cycle, eta={eta}{std}, "
                 f"c_eq={self.c_equivalent:.4g} N s/m at {self.freq:.4g} Hz, X={self.amplitude:.4g} m, "
                 f"{self.n_cycles} cycles{', ' + ', '.join(self.flags) if self.flags else ''})")

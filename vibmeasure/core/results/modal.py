@@ -191,7 +191,8 @@ class ModalEstimate:
                              "flags": [",".join(f) for f in self.mode_flags]})
 
     def __repr__(self) -> str:
-        rows = "; ".join(f"fn={f:.6g}±{fs:.2g} Hz zeta={z:.5g}±{zs:.2g}"
+        from ..rounding import with_std
+        rows = "; ".join("fn={}±{} Hz zeta={}±{}".format(*with_std(f, fs), *with_std(z, zs))
                          for f, fs, z, zs in zip(self.fn, self.fn_std, self.zeta, self.zeta_std))
         fl = f" flags={list(self.flags)}" if self.flags else ""
         return f"ModalEstimate({self.method}: {rows}{fl})"
