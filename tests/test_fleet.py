@@ -449,7 +449,7 @@ def test_trend_lists_every_asset_and_judges_a_fault_present_from_the_start(tmp_p
     assert assets["faulty"] == "alarm" and assets["new"] == "no baseline yet" and assets["zone-d"] == "alarm"
     assert assets["warm"] == "ok", tr[tr.asset == "warm"][["metric", "verdict", "reason"]].to_string()
     row = tr[(tr.asset == "faulty") & (tr.metric == "diagnosis")].iloc[0]
-    assert "bearing_inner_race named at 1.00 in the last two" in row.reason
+    assert "bearing inner race named at 1.00 in the last two" in row.reason
     vel = tr[(tr.asset == "faulty") & (tr.metric == "velocity_rms_mm_s")].iloc[0]
     assert vel["n"] == 12   # the measurement with two results counts once
     assert tr[(tr.asset == "warm") & (tr.metric == "velocity_rms_mm_s")]["alarm_date"].isna().all()

@@ -1088,3 +1088,24 @@ def test_an_answer_at_a_speed_nothing_confirms_is_held(shared_data):
     for s in range(3):
         rub = vm.synth.machine(fault="none", shaft_impacts=0.5, snr_db=0, seed=7000 + s, duration=6.0)
         assert vm.diagnose(rub, bearing="6205-2RS", gear=32).top != "gear_mesh"
+
+
+def test_an_acceleration_declared_as_velocity_is_doubted_not_diagnosed(shared_data):
+    """Issue 46: a channel declared mm/s that holds an acceleration (most of its power above 1 kHz) was
+    differentiated and called a fault at full confidence. The unit is doubted (flag, reason, confidence
+    held under 0.5, no ISO zone); the same record integrated to a true velocity is diagnosed as before."""
+    rec = vm.read(shared_data("cwru_fe/OR007@12_1.mat"), fs=12000, unit="g")
+    wrong = vm.Record.from_array(rec.data, fs=rec.fs, names=list(rec.names), unit="mm/s")
+    d = vm.diagnose(wrong, rpm=rec.meta["rpm"], bearing="6203-2RS")
+    assert "unit_doubtful" in d.flags and d.confidence < 0.5 and d.severity["zone"] is None
+    assert "check the unit" in d.reason
+    right = vm.diagnose(vm.integrate(rec).to_unit("mm/s"), rpm=rec.meta["rpm"], bearing="6203-2RS")
+    assert "unit_doubtful" not in right.flags and right.severity["zone"] is not None
+    from vibmeasure.monitor.diagnosis.job import UNIT_DOUBT_SHARE
+    # the rule's margin on this record: its least high-frequency channel, as acceleration and as velocity
+    from scipy.signal import welch
+    def share(x):
+        f, p = welch(x - x.mean(), fs=rec.fs, nperseg=8192)
+        return p[(f > 1000) & (f <= 0.45 * rec.fs)].sum() / p[(f >= 10) & (f <= 1000)].sum()
+    v = vm.integrate(rec)
+    assert min(share(x) for x in rec.data) > UNIT_DOUBT_SHARE > min(share(x) for x in v.data)

@@ -262,3 +262,49 @@ def test_a_symlinked_database_store_writes_the_real_file(tmp_path):
         st.add_asset("pump-2")
     assert link.is_symlink()
     assert sorted(vm.Store(real).assets()["asset"]) == ["pump-1", "pump-2"]
+
+
+def test_the_alarm_history_keeps_each_change_of_verdict(target, tmp_path):
+    """Issue 47: the database holds alarms and their history. Each change of a trend verdict per asset,
+    point and metric is one row (the first evaluation starts the history); the same verdicts again
+    write nothing; a metric that returns to ok is a new row; a store from before the table reads an
+    empty history."""
+    import pandas as pd
+    url, raw = target
+    with vm.Store(url, writable=True, raw_dir=raw) as st:
+        def verdicts(v, last):
+            return pd.DataFrame({"asset": ["pump-1"], "point": ["DE"], "task": ["diagnose"],
+                                 "metric": ["velocity_rms_mm_s"], "verdict": [v], "last": [last],
+                                 "watch_limit": [2.8], "alarm_limit": [4.5], "reason": [f"velocity {last}"],
+                                 "last_time": [pd.Timestamp("2026-11-28T08:00", tz="UTC")]})
+        assert st.record_verdicts(verdicts("ok", 1.0)) == 1
+        assert st.record_verdicts(verdicts("ok", 1.1)) == 0             # no change, no row
+        assert st.record_verdicts(verdicts("alarm", 7.2)) == 1
+        assert st.record_verdicts(verdicts("ok", 1.2)) == 1             # cleared: its own row
+    h = vm.Store(url, raw_dir=raw).alarms(asset="pump-1")
+    assert h["verdict"].tolist() == ["ok", "alarm", "ok"]
+    assert h["limit"].tolist()[1] == 4.5 and h["value"].tolist() == [1.0, 7.2, 1.2]
+    assert str(h["time"].iloc[0]) == "2026-11-28 08:00:00+00:00"
+
+
+def test_batch_records_the_alarms_of_the_assets_it_ran(tmp_path):
+    """vm.batch writes the touched assets' verdict changes into the history: a pump whose last two
+    records carry an outer-race fault is in alarm from that run on; a re-run adds nothing."""
+    lines = ["file,asset,point,rpm,bearing,time"]
+    for i in range(12):
+        rec = vm.synth.machine(fault="none" if i < 10 else "bearing_outer_race", rpm=1500.0, fs=25600.0,
+                               duration=1.0, seed=i)
+        vm.write(tmp_path / f"r{i}.h5", rec)
+        lines.append(f"r{i}.h5,pump,DE,1500,6205-2RS,2026-03-{i + 1:02d}T00:00:00")
+    (tmp_path / "m.csv").write_text("\n".join(lines) + "\n")
+    vm.batch(manifest=tmp_path / "m.csv", task="diagnose", store=tmp_path / "plant.db")
+    h = vm.Store(tmp_path / "plant.db").alarms()
+    got = dict(zip(h["metric"], h["verdict"]))
+    assert got["diagnosis"] == "alarm" and "bearing outer race" in h[h["metric"] == "diagnosis"]["reason"].iloc[0]
+    vm.batch(manifest=tmp_path / "m.csv", task="diagnose", store=tmp_path / "plant.db")
+    assert len(vm.Store(tmp_path / "plant.db").alarms()) == len(h)
+    import io
+    from vibmeasure.cli import main
+    out = io.StringIO()
+    assert main(["store", "alarms", str(tmp_path / "plant.db")], out=out, err=io.StringIO()) == 0
+    assert "pump/DE  diagnosis: alarm" in out.getvalue() and "bearing outer race named at" in out.getvalue()

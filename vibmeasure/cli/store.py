@@ -9,8 +9,8 @@ def register(sub) -> None:
     """Add the command's parser to the subparsers ``sub``."""
     st = sub.add_parser("store", help="migrate an HDF5 store to SQLite/PostgreSQL, or count what a store holds",
                         description="vibmeasure store migrate OLD.h5 PLANT.db (or postgresql://user@host/db); "
-                                    "vibmeasure store info STORE.")
-    ops = st.add_subparsers(dest="op", required=True, help="migrate or info")
+                                    "vibmeasure store info STORE; vibmeasure store alarms STORE.")
+    ops = st.add_subparsers(dest="op", required=True, help="migrate, info or alarms")
     mg = ops.add_parser("migrate", help="copy an HDF5 store into a new database store (ids and raw records kept)")
     mg.add_argument("source", help="the HDF5 store (.h5)")
     mg.add_argument("target", help="the database: a .db/.sqlite file or a postgresql:// URL")
@@ -19,6 +19,10 @@ def register(sub) -> None:
     info = ops.add_parser("info", help="assets, points, measurements and results in a store")
     info.add_argument("store", help="an HDF5 store (.h5), a .db/.sqlite file or a database URL")
     info.add_argument("--json", action="store_true", help="print one JSON document")
+    al = ops.add_parser("alarms", help="the alarm history: each change of a trend verdict (database stores)")
+    al.add_argument("store", help="a .db/.sqlite file or a database URL")
+    al.add_argument("--asset", help="only this asset")
+    al.add_argument("--json", action="store_true", help="print one JSON document")
 
 
 def run(args, out, err) -> int:
@@ -44,6 +48,8 @@ def run(args, out, err) -> int:
                   f"{args.source}", file=out)
         return 0
     from ..io.store import Store
+    if args.op == "alarms":
+        return _alarms(args, out, Store)
     st = Store(args.store)
     try:
         n = {"assets": len(st.assets()), "points": len(st.points()), "measurements": st.n_measurements,
@@ -55,4 +61,28 @@ def run(args, out, err) -> int:
     else:
         print(f"{args.store}: {n['assets']} assets, {n['points']} points, {n['measurements']} measurements, "
               f"{n['errors']} inputs that failed", file=out)
+    return 0
+
+
+def _alarms(args, out, Store) -> int:
+    """The alarm history, oldest first: one line (or JSON row) per change of verdict."""
+    from ..core.labels import label
+    from ..core.rounding import plain
+    st = Store(args.store)
+    try:
+        h = st.alarms(asset=args.asset)
+    finally:
+        st.close()
+    if args.json:
+        rows = [{**r, "time": None if r["time"] is None or r["time"] != r["time"] else r["time"].isoformat(),
+                 "created": r["created"].isoformat()} for r in h.to_dict(orient="records")]
+        from ..core.results import jsonable
+        emit_json({"command": "store alarms", "store": args.store, "alarms": jsonable(rows)}, out)
+        return 0
+    if not len(h):
+        print(f"{args.store}: no alarm history (vm.batch records it in a database store)", file=out)
+    for r in h.itertuples():
+        when = "" if r.time is None or r.time != r.time else r.time.strftime("%Y-%m-%d %H:%M")
+        print(f"{when:16s}  {r.asset}/{r.point}  {label(r.metric)}: {r.verdict}  ({plain(r.value, 4)}; "
+              f"{r.reason})", file=out)
     return 0

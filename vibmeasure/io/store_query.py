@@ -208,6 +208,26 @@ class _Queries:
                 df = df[df[k] == v]
         return self._timed(df.reset_index(drop=True), since, until)
 
+    def alarms(self, asset: str | None = None, point: str | None = None):
+        """The alarm history, which only a database store keeps (``vm.Store("plant.db")``): an HDF5 store
+        returns it empty, with the database's columns; ``vm.trend`` gives its current verdicts.
+
+        Returns
+        -------
+        pandas.DataFrame
+            asset, point, task, metric, verdict, value, limit, reason, time, created (no rows).
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> len(vm.Store(pathlib.Path(tempfile.mkdtemp()) / "plant.h5", writable=True).alarms())
+        0
+        """
+        import pandas as pd
+        return pd.DataFrame(columns=["asset", "point", "task", "metric", "verdict", "value", "limit", "reason", "time",
+                                     "created"])
+
     def errors(self):
         """Inputs a batch could not analyse: measurement, file and the error message.
 

@@ -223,6 +223,7 @@ def _compare(store, asset, point, mid, results):
 def _store_one(store, out, tasks, keep_raw, options):
     item = out["item"]
     asset, point = _register(store, item, out.get("channels", []))
+    item["_asset"] = asset   # the caller's alarm history covers the assets a run touched
     rec = None
     if keep_raw and not out["errors"].get("read") and item.get("_mid") is None:
         rec = _read(item, options)
@@ -338,9 +339,12 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
         done = committed = 0
         last_commit = _time.monotonic()
 
+        touched: set = set()
+
         def take(out):
             nonlocal done, committed, last_commit
             mid = _store_one(st, out, tasks, keep_raw, options)
+            touched.add(out["item"].get("_asset"))
             err = "; ".join(f"{k}: {v}" for k, v in out["errors"].items())
             rows.append((out["item"]["file"], "error" if err else "done", mid, err))  # a short row per input
             done += 1
@@ -377,12 +381,29 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
                 if cluster is not True:
                     cluster.close()
         st.commit()
+        _record_alarms(st, touched)
     finally:
         _BASELINES.pop(id(st), None)
         if own:
             st.close()
     import pandas as pd
     return pd.DataFrame(rows, columns=["file", "status", "measurement", "message"])
+
+
+def _record_alarms(st, assets) -> None:
+    """The trend verdicts of the assets this run added to into the store's alarm history
+    (``Store.alarms``): a database store keeps each change of verdict; the HDF5 store has no history."""
+    assets = sorted(a for a in assets if a)
+    if not assets or not hasattr(st, "record_verdicts"):
+        return
+    import pandas as pd
+
+    from .trend import trend
+    frames = [trend(st, asset=a) for a in assets]
+    frames = [f for f in frames if len(f)]
+    if frames:
+        st.record_verdicts(pd.concat(frames, ignore_index=True))
+        st.commit()
 
 
 class _Stored:

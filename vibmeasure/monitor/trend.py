@@ -174,7 +174,8 @@ def _diagnosis_rows(df) -> list:
         level = 2 if len(last2) == 2 and all(last2) and g["top"].iloc[-1] == g["top"].iloc[-2] else \
             1 if named[-1] else 0 if len(g) > 1 else TOO_FEW
         top = g["top"].iloc[-1]
-        reason = (f"{top} named at {conf[-1]:.2f}" + (" in the last two measurements" if level == 2 else "")
+        from ..core.labels import label
+        reason = (f"{label(top)} named at {conf[-1]:.2f}" + (" in the last two measurements" if level == 2 else "")
                   if named[-1] else f"last diagnosis {top} ({conf[-1]:.2f}): no fault named")
         rows.append(_row(a, p, "diagnose", "diagnosis", len(g), float(conf[-1]), g["time"].iloc[-1], level,
                          reason))
@@ -247,7 +248,10 @@ def _relative(a, p, task, col, g, rule, baseline_count, horizon_days) -> dict:
     for lvl in (1, 2):
         j = next((j for j, h in enumerate(held) if h >= lvl), None)
         first[lvl] = None if j is None else g["time"].iloc[baseline_count + j + 1]
-    reason = f"{col} {y[-1]:.4g} against baseline {mu:.4g} +- {sd:.2g}"
+    from ..core.labels import label
+    from ..core.rounding import with_std
+    base, spread = with_std(mu, sd, digits=4)
+    reason = f"{label(col)} {y[-1]:.4g} against baseline {base} +- {spread}"
     if level:
         reason += f" (beyond the {LEVELS[level]} limit in the last two measurements)"
     elif lv[-1]:

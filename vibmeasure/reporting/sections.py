@@ -29,6 +29,8 @@ FLAG_ADVICE = {
     "low_coherence": "average more hits or shaker records; check for noise, nonlinearity or a loose sensor",
     "double_hit": "repeat the hit: a double hit corrupts the force spectrum",
     "not_impact": "use estimate_frf for shaker (continuous) excitation",
+    "unit_doubtful": "check the channel's unit and quantity (an accelerometer's g or m/s^2 declared as mm/s?) and "
+                     "analyse again",
     "bearing_not_checked": "give the bearing (catalogue name or geometry) so bearing faults are searched",
     "band_limited": "record a wider band (sample faster, open the anti-alias filter): bearing impacts ring in "
                     "resonances well above the shaft harmonics",

@@ -37,6 +37,8 @@ FLAG_TEXT = {
     "not_harmonic": "the motion is not one sinusoid (harmonics above 5 %): the equivalent viscous c assumes "
                     "harmonic motion and holds only as an energy equivalent",
     # machine diagnosis
+    "unit_doubtful": "a channel declared velocity or displacement carries most of its power above 1 kHz, as an "
+                     "acceleration does: the unit conversion, the levels and the ISO zone are in doubt",
     "bearing_not_checked": "no bearing given: bearing faults were not searched",
     "band_limited": "a channel measures only up to a filter's edge, too low to demodulate above the shaft "
                     "harmonics: the bearing evidence is weak",

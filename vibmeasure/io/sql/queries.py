@@ -150,6 +150,39 @@ class _SQLQueries:
         df["time"] = pd.to_datetime(df["time"], unit="s", utc=True)
         return df
 
+    def alarms(self, asset: str | None = None, point: str | None = None):
+        """The alarm history: every change of a trend verdict (``ok``, ``watch``, ``alarm``) per asset,
+        point and metric, oldest first, as ``record_verdicts`` wrote it (``vm.batch`` does after each
+        run): asset, point, task, metric, verdict, value, limit, reason, time (of the measurement that
+        set it) and created (when it was recorded).
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import vibmeasure as vm
+        >>> vm.Store(pathlib.Path(tempfile.mkdtemp()) / "p.db", writable=True).alarms().columns.tolist()[:5]
+        ['asset', 'point', 'task', 'metric', 'verdict']
+        """
+        import pandas as pd
+        import sqlalchemy as sa
+        cols = ["asset", "point", "task", "metric", "verdict", "value", "limit", "reason", "time", "created"]
+        a = _tables()["alarms"]
+        if "alarms" not in set(sa.inspect(self._conn).get_table_names()):   # a store from before the table
+            self._end_read()
+            return pd.DataFrame(columns=cols)
+        stmt = sa.select(a.c.asset, a.c.point, a.c.task, a.c.metric, a.c.verdict, a.c.value, a.c.limit_value,
+                         a.c.reason, a.c.time, a.c.created)
+        if asset is not None:
+            stmt = stmt.where(a.c.asset == str(asset))
+        if point is not None:
+            stmt = stmt.where(a.c.point == str(point))
+        rows = self._run(stmt.order_by(a.c.id)).all()
+        self._end_read()
+        df = pd.DataFrame(rows, columns=cols)
+        for c in ("time", "created"):
+            df[c] = pd.to_datetime(df[c].astype(float), unit="s", utc=True)
+        return df
+
     def errors(self):
         """Inputs a batch could not analyse: measurement, file and the error message (``Store.errors``).
 

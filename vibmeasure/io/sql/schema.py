@@ -55,6 +55,15 @@ def _schema():
              # (no statistics) then scanned every result of the task (0.31 s for one asset's year of 1M
              # results) instead of the asset's measurements and their results (0.06 s)
              sa.Index("ix_results_measurement_task", "measurement", "task"))
+    # each change of a trend verdict (ok / watch / alarm) per asset, point and metric: the alarm history
+    sa.Table("alarms", md,
+             sa.Column("id", sa.Integer, primary_key=True, autoincrement=True),
+             sa.Column("asset", sa.String(200), nullable=False), sa.Column("point", sa.String(200), nullable=False),
+             sa.Column("task", sa.String(200), nullable=False), sa.Column("metric", sa.String(200), nullable=False),
+             sa.Column("verdict", sa.String(16), nullable=False), sa.Column("value", sa.Float),
+             sa.Column("limit_value", sa.Float), sa.Column("reason", sa.Text),
+             sa.Column("time", sa.Float), sa.Column("created", sa.Float),
+             sa.Index("ix_alarms_asset_point_metric", "asset", "point", "task", "metric", "id"))
     return md
 
 

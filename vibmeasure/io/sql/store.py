@@ -27,6 +27,15 @@ from .queries import _SQLQueries
 from .schema import _dumps, _insert, _mid, _mnum, _short, _tables, _url
 
 
+def _number(v):
+    """A finite float, or None (JSON and SQL have no NaN to keep)."""
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return None
+    return v if v == v and abs(v) != float("inf") else None
+
+
 class SQLStore(_SQLQueries):
     """A condition-monitoring store on SQLite or PostgreSQL; ``vm.Store`` returns one for a database target.
 
@@ -411,6 +420,62 @@ class SQLStore(_SQLQueries):
                 raise ParameterError(f"raw_dir={str(self.raw_dir)!r}: cannot create it ({exc.strerror})") from None
             write_hdf5(path, record)
         return key
+
+    def record_verdicts(self, verdicts) -> int:
+        """Write the trend verdicts that changed into the alarm history (``alarms``): a row per asset,
+        point, task and metric whose verdict differs from the last one recorded (the first evaluation
+        is recorded too, so that the history starts). Part of the pending transaction.
+
+        Parameters
+        ----------
+        verdicts : pandas.DataFrame
+            ``vm.trend`` of this store (or of some of its assets).
+
+        Returns
+        -------
+        int
+            Rows written.
+
+        Raises
+        ------
+        ParameterError
+            For a store opened read-only.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> import pandas as pd
+        >>> import vibmeasure as vm
+        >>> st = vm.Store(pathlib.Path(tempfile.mkdtemp()) / "p.db", writable=True)
+        >>> v = pd.DataFrame({"asset": ["fan"], "point": ["DE"], "task": ["diagnose"], "metric": ["zone"],
+        ...                   "verdict": ["alarm"], "last": [7.2], "alarm_limit": [4.5], "watch_limit": [2.8],
+        ...                   "reason": ["ISO zone D"], "last_time": [pd.Timestamp("2026-11-28", tz="UTC")]})
+        >>> st.record_verdicts(v), st.record_verdicts(v)
+        (1, 0)
+        """
+        import sqlalchemy as sa
+        self._need_writable()
+        a = _tables()["alarms"]
+        last = {}
+        for row in self._run(sa.select(a.c.asset, a.c.point, a.c.task, a.c.metric, a.c.verdict).order_by(a.c.id)):
+            last[tuple(row[:4])] = row[4]
+        out, now = [], _time.time()
+        for r in verdicts.to_dict(orient="records"):
+            key = (str(r["asset"]), str(r["point"]), str(r.get("task") or ""), str(r["metric"]))
+            if last.get(key) == r["verdict"]:
+                continue
+            limit = r.get("alarm_limit") if r["verdict"] == "alarm" else r.get("watch_limit")
+            t = r.get("last_time")
+            out.append({"asset": key[0], "point": key[1], "task": key[2], "metric": key[3], "verdict": str(r["verdict"]),
+                        "value": _number(r.get("last")), "limit_value": _number(limit),
+                        "reason": str(r.get("reason") or ""),
+                        "time": None if t is None or t != t else float(getattr(t, "timestamp", lambda: t)()),
+                        "created": now})
+            last[key] = r["verdict"]
+        if out:
+            self._run(a.insert(), out)
+            self._n_pending += len(out)
+        return len(out)
 
     def add_result(self, measurement: str, task: str, result: dict, *, params: dict | None = None,
                    summary: dict | None = None) -> None:

@@ -185,10 +185,27 @@ def ball_slip_edge(ev, job, top: str, conf: float, reason: str) -> tuple[float, 
                  "the humps follow 2 x BSF", conf, reason)
 
 
+def unit_label(job, severity: dict, conf: float, reason: str) -> tuple[float, str]:
+    """A channel declared velocity or displacement whose content is an acceleration's (``job.
+    _unit_plausibility``: most of its power above 1 kHz): the conversion the answer rests on (one or
+    two differentiations) is in doubt, and with it every level and the ISO zone. CWRU OR007@12_1, its
+    acceleration declared mm/s, was called a ball fault at full confidence."""
+    if "unit_doubtful" not in job.flags:
+        return conf, reason
+    if severity.get("zone") is not None:
+        severity["zone"] = None
+        severity["note"] = "; ".join(filter(None, [severity.get("note", ""), "no zone: the unit is in doubt"]))
+    return _held(job.flags, "unit_doubtful", f"the channel declared {next(iter(job.converted.values()))} holds "
+                 f"{job.unit_share:.2g}x more power above 1 kHz than in 10-1000 Hz, as an acceleration does: check "
+                 "the unit", conf, reason)
+
+
 def hold_all(run, ev, severity: dict, top: str, conf: float, reason: str) -> tuple[float, str]:
-    """Every doubt in turn: the time base, a speed the file contradicts, a speed nothing confirms, a
-    factor 2 (half-harmonics, a rival comb), a smeared ball at its slip's edge, the user's band."""
+    """Every doubt in turn: the time base, the unit, a speed the file contradicts, a speed nothing
+    confirms, a factor 2 (half-harmonics, a rival comb), a smeared ball at its slip's edge, the user's
+    band."""
     conf, reason = time_base(run.speed, severity, run.job.flags, conf, reason)
+    conf, reason = unit_label(run.job, severity, conf, reason)
     conf, reason = file_speed(run, conf, reason)
     conf, reason = unconfirmed_speed(run, conf, reason)
     conf, reason = half_speed(ev, run.job, conf, reason)
