@@ -212,10 +212,20 @@ class _Queries:
         """The alarm history, which only a database store keeps (``vm.Store("plant.db")``): an HDF5 store
         returns it empty, with the database's columns; ``vm.trend`` gives its current verdicts.
 
+        Parameters
+        ----------
+        asset, point : str, optional
+            Only this asset or point (a database store filters by them).
+
         Returns
         -------
         pandas.DataFrame
             asset, point, task, metric, verdict, value, limit, reason, time, created (no rows).
+
+        Raises
+        ------
+        ParameterError
+            Never for an open store.
 
         Examples
         --------

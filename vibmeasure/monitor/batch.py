@@ -354,32 +354,7 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
                 st.commit()
                 committed, last_commit = done, _time.monotonic()
 
-        dask_client, cluster = _client(client, workers, scheduler)
-        try:
-            if dask_client is None:
-                for it in todo:
-                    take(analyse_file(it, tasks, options))
-            else:
-                from distributed import as_completed
-                # a few inputs per task, one map call, results taken in batches: a task per input cost the
-                # client, which also hosts a local scheduler, 7-8 ms of CPU per input (a sixth of a core at
-                # 24 records/s on 2 cores), time the workers then lacked
-                n_w = max(1, len(dask_client.scheduler_info().get("workers", {})))
-                size = max(1, min(MAX_PER_TASK, len(todo) // (8 * n_w)))
-                chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
-                futs = dask_client.map(analyse_files, chunks, tasks=tasks, options=options, retries=2, pure=False)
-                # the futures' own client's loop: as_completed otherwise takes the default client's, and
-                # with two clients in one process that can hang (dask/distributed issue 4357)
-                for batch_done in as_completed(futs, loop=dask_client.loop, with_results=True).batches():
-                    for fut, outs in batch_done:
-                        for out in outs:
-                            take(out)
-                        fut.release()
-        finally:
-            if cluster is not None:  # a client (and cluster) this call started is closed by it
-                dask_client.close()
-                if cluster is not True:
-                    cluster.close()
+        _execute(todo, tasks, options, take, client, workers, scheduler)
         st.commit()
         _record_alarms(st, touched)
     finally:
@@ -388,6 +363,37 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
             st.close()
     import pandas as pd
     return pd.DataFrame(rows, columns=["file", "status", "measurement", "message"])
+
+
+def _execute(todo, tasks, options, take, client, workers, scheduler) -> None:
+    """Analyse the inputs, serially or on Dask, handing each outcome to ``take`` (the client alone
+    writes the store)."""
+    dask_client, cluster = _client(client, workers, scheduler)
+    try:
+        if dask_client is None:
+            for it in todo:
+                take(analyse_file(it, tasks, options))
+        else:
+            from distributed import as_completed
+            # a few inputs per task, one map call, results taken in batches: a task per input cost the
+            # client, which also hosts a local scheduler, 7-8 ms of CPU per input (a sixth of a core at
+            # 24 records/s on 2 cores), time the workers then lacked
+            n_w = max(1, len(dask_client.scheduler_info().get("workers", {})))
+            size = max(1, min(MAX_PER_TASK, len(todo) // (8 * n_w)))
+            chunks = [todo[i:i + size] for i in range(0, len(todo), size)]
+            futs = dask_client.map(analyse_files, chunks, tasks=tasks, options=options, retries=2, pure=False)
+            # the futures' own client's loop: as_completed otherwise takes the default client's, and
+            # with two clients in one process that can hang (dask/distributed issue 4357)
+            for batch_done in as_completed(futs, loop=dask_client.loop, with_results=True).batches():
+                for fut, outs in batch_done:
+                    for out in outs:
+                        take(out)
+                    fut.release()
+    finally:
+        if cluster is not None:  # a client (and cluster) this call started is closed by it
+            dask_client.close()
+            if cluster is not True:
+                cluster.close()
 
 
 def _record_alarms(st, assets) -> None:

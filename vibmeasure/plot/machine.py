@@ -108,7 +108,13 @@ def plot_diagnosis(rec, diag, *, axes=None):
         for ax in (ax_e, ax_k):
             if ax is not None and ax.get_xlabel():
                 ax.set_xlabel(f"order x the mean speed {f1:.2f} Hz [Hz]")
-    sev = diag.severity
+    _plot_gauge(ax_g, diag.severity)
+    return axes
+
+
+def _plot_gauge(ax_g, sev):
+    """The ISO 10816-3 severity gauge: the zones of the machine's group and foundation, the measured
+    velocity as a bar, the scale on the right."""
     from ..monitor.diagnosis import ISO_10816_3
     ab, bc, cd = ISO_10816_3[(sev["group"], sev["foundation"])]
     top = cd * 1.5
@@ -118,7 +124,7 @@ def plot_diagnosis(rec, diag, *, axes=None):
     v = sev.get("velocity_rms_mm_s")
     if v is not None:
         ax_g.plot([-0.35, 0.35], [min(v, top)] * 2, color="k", lw=3)
-        ax_g.set_title(f"ISO 10816-3\n{v:.2f} mm/s: zone {sev['zone']}", fontsize=8)
+        ax_g.set_title(f"ISO 10816-3\n{v:.2f} mm/s: zone {sev['zone'] or 'withheld'}", fontsize=8)
     ax_g.grid(False)
     ax_g.set_xlim(-0.5, 0.6)
     ax_g.set_ylim(0, top)
@@ -126,7 +132,6 @@ def plot_diagnosis(rec, diag, *, axes=None):
     ax_g.yaxis.tick_right()                  # the label beside its own scale, clear of the plots on the left
     ax_g.yaxis.set_label_position("right")
     ax_g.set_ylabel("velocity RMS [mm/s]")
-    return axes
 
 
 def _plot_ses(ax, ses, diag, colors):
