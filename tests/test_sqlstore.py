@@ -281,6 +281,10 @@ def test_the_alarm_history_keeps_each_change_of_verdict(target, tmp_path):
         assert st.record_verdicts(verdicts("ok", 1.1)) == 0             # no change, no row
         assert st.record_verdicts(verdicts("alarm", 7.2)) == 1
         assert st.record_verdicts(verdicts("ok", 1.2)) == 1             # cleared: its own row
+        with pytest.raises(vm.ParameterError, match="must be a vm.trend frame"):
+            st.record_verdicts([{"asset": "pump-1"}])
+        with pytest.raises(vm.ParameterError, match="verdict values must be"):
+            st.record_verdicts(verdicts("red", 9.0))
     h = vm.Store(url, raw_dir=raw).alarms(asset="pump-1")
     assert h["verdict"].tolist() == ["ok", "alarm", "ok"]
     assert h["limit"].tolist()[1] == 4.5 and h["value"].tolist() == [1.0, 7.2, 1.2]

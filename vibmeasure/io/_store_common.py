@@ -29,6 +29,9 @@ def check_row(table: str, row, src: str) -> dict:
     return row
 
 
+# the alarm history's columns (a database store's ``alarms`` table; an HDF5 store's is empty)
+ALARM_COLUMNS = ("asset", "point", "task", "metric", "verdict", "value", "limit", "reason", "time", "created")
+VERDICT_COLUMNS = ("asset", "point", "metric", "verdict")   # what ``record_verdicts`` needs of a trend frame
 TASK_ALIASES = {"diagnosis": "diagnose", "modal": "modes", "spectra": "spectrum", "comparison": "compare"}
 
 

@@ -7,7 +7,7 @@ import json
 import numpy as np
 
 from ..core.errors import ParameterError
-from ._store_common import TASK_ALIASES, _hash_key, _seconds, check_row
+from ._store_common import ALARM_COLUMNS, TASK_ALIASES, _hash_key, _seconds, check_row
 
 
 class _Queries:
@@ -235,8 +235,7 @@ class _Queries:
         0
         """
         import pandas as pd
-        return pd.DataFrame(columns=["asset", "point", "task", "metric", "verdict", "value", "limit", "reason", "time",
-                                     "created"])
+        return pd.DataFrame(columns=list(ALARM_COLUMNS))
 
     def errors(self):
         """Inputs a batch could not analyse: measurement, file and the error message.

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ...core.errors import ParameterError
-from .._store_common import TASK_ALIASES, _seconds
+from .._store_common import ALARM_COLUMNS, TASK_ALIASES, _seconds
 from .schema import _RAW_KEY, _loads, _many, _mid, _mnum, _tables
 
 
@@ -165,7 +165,7 @@ class _SQLQueries:
         """
         import pandas as pd
         import sqlalchemy as sa
-        cols = ["asset", "point", "task", "metric", "verdict", "value", "limit", "reason", "time", "created"]
+        cols = list(ALARM_COLUMNS)
         a = _tables()["alarms"]
         if "alarms" not in set(sa.inspect(self._conn).get_table_names()):   # a store from before the table
             self._end_read()

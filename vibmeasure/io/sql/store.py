@@ -21,7 +21,7 @@ from pathlib import Path
 
 from ...core._validate import regular_input
 from ...core.errors import ParameterError
-from .._store_common import STORE_SCHEMA, STORE_VERSION, StoreLockedError, _asset_row, _check_name, _seconds
+from .._store_common import VERDICT_COLUMNS, STORE_SCHEMA, STORE_VERSION, StoreLockedError, _asset_row, _check_name, _seconds
 from . import schema as _schema_mod
 from .queries import _SQLQueries
 from .schema import _dumps, _insert, _mid, _mnum, _short, _tables, _url
@@ -455,6 +455,13 @@ class SQLStore(_SQLQueries):
         """
         import sqlalchemy as sa
         self._need_writable()
+        missing = [c for c in VERDICT_COLUMNS if c not in getattr(verdicts, "columns", ())]
+        if missing:
+            raise ParameterError(f"verdicts must be a vm.trend frame (columns {list(VERDICT_COLUMNS)} at least); "
+                                 f"got {type(verdicts).__name__} without {missing}")
+        bad = sorted({str(v) for v in verdicts["verdict"]} - {"ok", "watch", "alarm", "no baseline yet"})
+        if bad:
+            raise ParameterError(f"verdicts: verdict values must be ok, watch, alarm or 'no baseline yet', got {bad}")
         a = _tables()["alarms"]
         last = {}
         for row in self._run(sa.select(a.c.asset, a.c.point, a.c.task, a.c.metric, a.c.verdict).order_by(a.c.id)):
