@@ -61,14 +61,14 @@ def draw(out: Path) -> list[Path]:
     # ring-down, backbone
     two = vm.synth.free_decay(fn=[18.0, 150.0], zeta=[0.01, 0.05], amplitude=[1.0, 20.0], fs=1000.0, duration=6.0,
                               snr_db=50, seed=4, quantity="displacement", unit="mm")
-    save(plot.plot_ringdown(two, vm.ringdown(two, band=(10.0, 30.0)))[0].figure, "ringdown.png")
+    save(plot.plot_ringdown(two, vm.ringdown(two, band=(10.0, 30.0))), "ringdown.png")
     t = np.arange(60000) / 2000.0
     amp = 1.0 * np.exp(-0.25 * t) - 0.01 * t      # friction-like decay of the envelope
     amp = np.clip(amp, 0, None)
     inst = 2 * np.pi * np.cumsum(12.0 * np.sqrt(1 - 0.06 * amp ** 2)) / 2000.0   # softening (Duffing) backbone
     x = amp * np.cos(inst) + 1e-3 * np.random.default_rng(2).normal(size=t.size)
     nl = vm.Record.from_array(x, fs=2000.0, quantity="displacement", unit="mm")
-    save(plot.plot_backbone(vm.ringdown(nl))[0].figure, "backbone.png")
+    save(plot.plot_backbone(vm.ringdown(nl)), "backbone.png")
 
     # spectra
     fs = 2048.0
@@ -78,11 +78,11 @@ def draw(out: Path) -> list[Path]:
     sig = sum(a * np.sin(2 * np.pi * f * tt) for f, a in tones) + 0.01 * np.random.default_rng(0).normal(size=tt.size)
     rec = vm.Record.from_array(sig, fs=fs, quantity="acceleration", unit="m/s^2")
     spec = vm.amplitude_spectrum(rec)
-    save(plot.plot_spectrum(spec, peaks=vm.pick_peaks(spec, n=10)).figure, "spectrum.png")
+    save(plot.plot_spectrum(spec, peaks=vm.pick_peaks(spec, n=10)), "spectrum.png")
     machine = vm.synth.machine(fault="bearing_outer_race", rpm=1500.0, fs=12800.0, duration=2.0, seed=1)
-    save(plot.plot_spectrum(vm.psd(machine), db=True).figure, "psd_db.png")
+    save(plot.plot_spectrum(vm.psd(machine), db=True), "psd_db.png")
     env = vm.envelope_spectrum(machine, band=(2000.0, 3200.0))
-    save(plot.plot_spectrum(env, peaks=vm.pick_peaks(env, n=6)).figure, "envelope.png")
+    save(plot.plot_spectrum(env, peaks=vm.pick_peaks(env, n=6)), "envelope.png")
 
     # hammer test, modes
     fn, zeta = [21.3, 57.9, 110.4], [0.010, 0.020, 0.015]
@@ -91,15 +91,15 @@ def draw(out: Path) -> list[Path]:
                                   seed=1)
     frf = vm.impact_frf(hammer, input="hammer")
     est = vm.fit_modes(frf, band=(5, 150))
-    save(plot.plot_frf(frf, est=est, output="a1")[0].figure, "frf.png")
-    save(plot.plot_nyquist(frf, band=(18, 25)).figure, "nyquist.png")
-    save(plot.plot_stabilisation(est, frf=frf).figure, "stabilisation.png")
-    save(plot.plot_mac(vm.mac(est.shapes, np.asarray(shapes)), labels=[f"{f:.1f}" for f in est.fn]).figure,
+    save(plot.plot_frf(frf, est=est, output="a1"), "frf.png")
+    save(plot.plot_nyquist(frf, band=(18, 25)), "nyquist.png")
+    save(plot.plot_stabilisation(est, frf=frf), "stabilisation.png")
+    save(plot.plot_mac(vm.mac(est.shapes, np.asarray(shapes)), labels=[f"{f:.1f}" for f in est.fn]),
          "mac.png")
 
     # diagnosis, comparison
     diag = vm.diagnose(machine, rpm=1500.0, bearing="6205-2RS")
-    save(plot.plot_diagnosis(machine, diag)[0].figure, "diagnosis.png")
+    save(plot.plot_diagnosis(machine, diag), "diagnosis.png")
     model = vm.models.MDOF(np.diag([1.0, 1.0, 1.0]),
                            np.array([[2e4, -1e4, 0], [-1e4, 2e4, -1e4], [0, -1e4, 1e4]]), modal_zeta=[0.02] * 3)
     softer = vm.models.MDOF(np.diag([1.0, 1.0, 1.0]),
@@ -107,19 +107,19 @@ def draw(out: Path) -> list[Path]:
                             modal_zeta=[0.02] * 3)
     amb = vm.synth.ambient(softer, fs=100.0, duration=300.0, noise=0.05, seed=1)
     oma = vm.oma_ssi(amb, band=(1, 40))
-    save(plot.plot_comparison(vm.compare(oma, model.modes())).figure, "comparison.png")
-    save(plot.plot_stabilisation(oma).figure, "oma_stabilisation.png")
-    save(plot.plot_singular_values(vm.oma_fdd(amb, band=(1, 40))).figure, "singular_values.png")
+    save(plot.plot_comparison(vm.compare(oma, model.modes())), "comparison.png")
+    save(plot.plot_stabilisation(oma), "oma_stabilisation.png")
+    save(plot.plot_singular_values(vm.oma_fdd(amb, band=(1, 40))), "singular_values.png")
 
     # shock, isolation
     sfs = 20000.0
     st = np.arange(int(0.05 * sfs)) / sfs
     pulse = np.where(st < 0.002, 50.0 * np.sin(np.pi * st / 0.002), 0.0)
     shock = vm.Record.from_array(np.r_[np.zeros(100), pulse], fs=sfs, quantity="acceleration", unit="g")
-    save(plot.plot_srs(vm.srs(shock, Q=10, output="pseudo_velocity")).figure, "srs.png")
+    save(plot.plot_srs(vm.srs(shock, Q=10, output="pseudo_velocity")), "srs.png")
     mount = vm.models.SDOF(m=1.0, k=(2 * np.pi * 10.0) ** 2, zeta=0.05)
     be = vm.synth.base_excited(mount, fs=500.0, duration=120.0, seed=1)
-    save(plot.plot_transmissibility(vm.transmissibility(be, base=be.names[0], top=be.names[1], model=mount)).figure,
+    save(plot.plot_transmissibility(vm.transmissibility(be, base=be.names[0], top=be.names[1], model=mount)),
          "transmissibility.png")
 
     # fleet trend
@@ -128,7 +128,7 @@ def draw(out: Path) -> list[Path]:
         vm.synth.fleet(Path(d) / "fleet", n_measurements=20, fault_onset=10)
         store = Path(d) / "plant.db"
         vm.batch(task="diagnose", store=store, manifest=Path(d) / "fleet" / "machines.csv")
-        save(plot.plot_trend(store, asset="pump-3", point="DE", metric="bearing_evidence", baseline_count=6).figure,
+        save(plot.plot_trend(store, asset="pump-3", point="DE", metric="bearing_evidence", baseline_count=6),
              "trend.png")
     return written
 

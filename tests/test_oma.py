@@ -209,9 +209,9 @@ def test_plots_have_units(chain):
     truth, sensors, rec = chain
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", vm.QualityWarning)
-        ax = plot_singular_values(vm.oma_fdd(rec, band=(1, 80)))
+        ax = plot_singular_values(vm.oma_fdd(rec, band=(1, 80))).panels[0]
     assert ax.get_xlabel() == "frequency [Hz]" and "m/s^2" in ax.get_ylabel()
-    ax = plot_stabilisation(vm.oma_ssi(rec, band=(1, 80)))
+    ax = plot_stabilisation(vm.oma_ssi(rec, band=(1, 80))).panels[0]
     assert ax.get_ylabel() == "model order" and "PSD" in ax.figure.axes[-1].get_ylabel()
 
 

@@ -43,10 +43,10 @@ def test_frf_plots_draw(tmp_path):
     est = vm.fit_modes(fr, band=(1, 150))
     am, ap, ac = plot_frf(fr, est=est)
     assert len(am.get_lines()) >= 2  # measured and synthesised
-    assert plot_nyquist(fr, band=(18, 25)).get_lines()
-    ax = plot_stabilisation(est, frf=fr)
+    assert plot_nyquist(fr, band=(18, 25)).panels[0].get_lines()
+    ax = plot_stabilisation(est, frf=fr).panels[0]
     assert any(l.get_label() == "stable f" for l in ax.get_lines())
-    assert plot_mac(vm.mac(est.shapes), labels=["1", "2"]).images
+    assert plot_mac(vm.mac(est.shapes), labels=["1", "2"]).panels[0].images
     plt.close("all")
     with pytest.raises(vm.ParameterError, match="vm.fit_modes"):
         plot_stabilisation(vm.ringdown(vm.synth.free_decay(fn=10.0, zeta=0.02, fs=1000.0, duration=2.0)))
@@ -68,12 +68,12 @@ def test_every_plot_labels_its_axes_with_quantity_and_unit():
     est_m = vm.fit_modes(frf, band=(2, 45))
     am, ap, ac = P.plot_frf(frf, est=est_m)
     labels += [am.get_ylabel(), ap.get_ylabel(), ac.get_xlabel()]
-    ny = P.plot_nyquist(frf)
+    ny = P.plot_nyquist(frf).panels[0]
     labels += [ny.get_xlabel(), ny.get_ylabel()]
-    st = P.plot_stabilisation(est_m, frf=frf)
+    st = P.plot_stabilisation(est_m, frf=frf).panels[0]
     labels += [st.get_xlabel()]
     assert st.get_xlim()[0] >= 2 - 1e-9 and st.get_xlim()[1] <= 45 + 1e-9  # the fitted band, not 0..fs/2
-    mac = P.plot_mac(vm.mac(np.eye(2)))
+    mac = P.plot_mac(vm.mac(np.eye(2))).panels[0]
     assert mac.get_xlabel() and mac.get_ylabel()
     mrec = vm.synth.machine(fault="bearing_outer_race", rpm=1500.0, fs=12800.0, duration=2.0, seed=1)
     diag = vm.diagnose(mrec, rpm=1500.0, bearing="6205-2RS")
@@ -101,7 +101,7 @@ def test_peak_labels_never_print_on_top_of_each_other():
     x = sum(a * np.sin(2 * np.pi * f * t) for f, a in tones)
     spec = vm.amplitude_spectrum(vm.Record.from_array(x, fs=fs, quantity="acceleration", unit="m/s^2"))
     peaks = vm.pick_peaks(spec, n=10)
-    ax = plot_spectrum(spec, peaks=peaks)
+    ax = plot_spectrum(spec, peaks=peaks).panels[0]
     ax.figure.canvas.draw()
     boxes = [a.get_window_extent() for a in ax.texts]
     assert len(boxes) >= 6  # most are labelled
@@ -119,9 +119,9 @@ def test_envelope_spectrum_axis_ends_where_its_content_ends_and_db_is_labelled()
     from vibmeasure.plot import plot_spectrum
     rec = vm.synth.machine(fault="bearing_outer_race", rpm=1500.0, fs=12800.0, duration=2.0, seed=1)
     env = vm.envelope_spectrum(rec, band=(2000.0, 3200.0))
-    ax = plot_spectrum(env)
+    ax = plot_spectrum(env).panels[0]
     assert 1100.0 < ax.get_xlim()[1] < 2200.0, ax.get_xlim()
-    ax = plot_spectrum(vm.psd(rec), db=True)
+    ax = plot_spectrum(vm.psd(rec), db=True).panels[0]
     assert "dB re 1" in ax.get_ylabel() and ax.get_yscale() == "linear"
     lo, hi = ax.get_ylim()
     assert hi - lo <= 110  # a readable dynamic range, not 300 dB down to the round-off
@@ -159,9 +159,8 @@ def test_every_plot_shares_the_one_style():
     freq = np.arange(0, 50.0625, 0.0625)
     frf = vm.synth.modal_frf(freq, fn=[10.0, 30.0], zeta=[0.02, 0.02], shapes=[[1.0, 0.7]])
     est_m = vm.fit_modes(frf, band=(2, 45))
-    figs = [P.plot_ringdown(rec, vm.ringdown(rec))[0].figure, P.plot_spectrum(vm.psd(rec)).figure,
-            P.plot_frf(frf, est=est_m)[0].figure, P.plot_nyquist(frf).figure,
-            P.plot_stabilisation(est_m, frf=frf).figure, P.plot_mac(vm.mac(np.eye(2))).figure]
+    figs = [P.plot_ringdown(rec, vm.ringdown(rec)), P.plot_spectrum(vm.psd(rec)), P.plot_frf(frf, est=est_m),
+            P.plot_nyquist(frf), P.plot_stabilisation(est_m, frf=frf), P.plot_mac(vm.mac(np.eye(2)))]
     for fig in figs:
         assert isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine)
         ax = fig.axes[0]
@@ -198,8 +197,32 @@ def test_names_are_text_not_math(tmp_path, name):
     and recurse past Python's limit on the second."""
     import matplotlib.pyplot as plt
     rec = vm.Record(np.sin(np.arange(4096) / 7.0)[None], 1000.0, channels=[vm.Channel(name, "acceleration", "m/s^2")])
-    ax = vm.plot.plot_spectrum(vm.amplitude_spectrum(rec))
+    ax = vm.plot.plot_spectrum(vm.amplitude_spectrum(rec)).panels[0]
     ax.figure.savefig(tmp_path / "s.png")
     texts = [t.get_text() for t in ax.figure.findobj(lambda o: hasattr(o, "get_text"))]
     assert any(name in t for t in texts)
     plt.close(ax.figure)
+
+
+def test_every_plot_function_returns_its_figure_with_the_panels_in_the_documented_order(tmp_path):
+    # one return type for every picture (issue 49): the Figure, its axes in fig.panels. A figure the
+    # function made unpacks into its panels (scripts written for the axes-returning 0.1 keep working);
+    # on axes the caller gives, the caller's own figure comes back
+    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
+    from vibmeasure import plot as P
+    rec = vm.synth.free_decay(fn=12.0, zeta=0.02, fs=500.0, duration=6.0, snr_db=40, seed=2)
+    fig = P.plot_ringdown(rec, vm.ringdown(rec))
+    assert isinstance(fig, Figure) and len(fig.panels) == 2 and set(fig.panels) <= set(fig.axes)
+    ax, axr = fig
+    assert fig[1] is axr and axr.get_xlabel() == "time [s]"
+    spec = vm.psd(rec)
+    fig = P.plot_spectrum(spec)
+    assert isinstance(fig, Figure) and fig.panels == (fig.axes[0],)
+    with pytest.raises(AttributeError, match=r"fig\.panels"):   # an Axes method on the Figure says where the axes are
+        fig.set_xlim(0, 10)
+    own, mine = plt.subplots()
+    assert P.plot_spectrum(spec, ax=mine) is own and own.panels == (mine,)
+    P.save_figure(fig, tmp_path / "s.png")       # a figure that unpacks is still saved like any other
+    assert (tmp_path / "s.png").stat().st_size > 1000
+    plt.close("all")

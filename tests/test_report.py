@@ -187,3 +187,64 @@ def test_vibmeasure_demo_command(tmp_path):
                            capture_output=True, text=True, timeout=300)  # inputs reused, stored ones skipped
     assert again.returncode == 0 and "synthesising" not in again.stderr
     assert np.isfinite(float(re.search(r"done in (\d+) s", again.stdout).group(1)))
+
+
+def test_results_computed_already_are_reported_as_they_are(tmp_path):
+    """vm.report takes results (issue 49): an estimate alone gives its tables; paired with its source it
+    also gets the figures that need the data; nothing is analysed again (the numbers are the result's)."""
+    import warnings
+    rec = vm.synth.free_decay(fn=12.0, zeta=0.02, fs=100.0, duration=6.0, snr_db=40, seed=2)
+    rec = vm.Record(rec.data, rec.fs, channels=rec.channels, meta={"source": "beam"})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        est = vm.ringdown(rec)
+    freq = np.arange(0, 50.0625, 0.0625)
+    frf = vm.synth.modal_frf(freq, fn=[10.0, 30.0], zeta=[0.02, 0.02], shapes=[[1.0, 0.7]])
+    modes = vm.fit_modes(frf, band=(2, 45))
+    cmp = vm.compare(est, vm.models.SDOF(m=1.0, k=5684.89, zeta=0.02))
+    failures = []
+    out = vm.report([(rec, est), est, (frf, modes), cmp, (frf, est)], tmp_path / "given.html", failures=failures)
+    html, page, text = _parse(out)
+    titles = re.findall(r"<h2>(.*?)</h2>", html)
+    assert titles[:4] == ["Ring-down: beam", "Ring-down: ModalEstimate (input 2)", "FRF and modes: FRF dof0/dof0",
+                          "Comparison: Comparison (input 4)"]
+    assert "an FRF pairs with a fit_modes estimate" in failures[0][1]   # a pair that cannot belong together
+    # the record's figure only with the record (ring-down and residual), the FRF's only with the FRF
+    assert html.count("record, fitted decay and envelope") == 1 and html.count("FRF magnitude, phase") == 1
+    assert html.count("damping and frequency versus amplitude") == 2    # the backbone needs the estimate only
+    assert html.count("<svg") == 2 + 1 + 2 + 1
+    shown = re.search(r"fn ([\d.]+) Hz, zeta ([\d.]+)", text)
+    assert float(shown[1]) == pytest.approx(est.fn[0], rel=1e-4)        # the result's own number, rounded
+    assert "given as a result (ml)" in text and "given as a result (fit_modes)" in text
+
+
+def test_a_ringdown_plot_and_its_report_show_the_same_flags(tmp_path):
+    """The flags in the picture's title are the report's flag list: the record's and each mode's, once
+    each, the informational noise_floor in neither (issue 49)."""
+    import warnings
+    import matplotlib.pyplot as plt
+    from vibmeasure.core.results._common import shown_flags
+    rec = vm.synth.free_decay(fn=12.0, zeta=0.02, fs=100.0, duration=6.0, snr_db=40, seed=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        est = vm.ringdown(rec)
+    flags = shown_flags(est.flags, est.mode_flags)
+    assert "resolution_limited" in flags and "noise_floor" not in flags   # fs/fn = 8.3: flagged
+    title = vm.plot.plot_ringdown(rec, est).panels[0].get_title()
+    plt.close("all")
+    assert title.split("flags: ")[1].split(", ") == flags
+    html = vm.report([(rec, est)], tmp_path / "f.html").read_text(encoding="utf-8")
+    assert re.findall(r'<div class="flag"><strong>(\w+)</strong>', html) == flags
+
+
+def test_a_backbone_model_that_does_not_fit_prints_no_parameter():
+    # a model that fails its goodness-of-fit test has NaN parameters: the report says so and why, and
+    # prints no number from it; a model that fits lists each parameter with its std
+    from vibmeasure.reporting.sections import _backbone_model_table
+    t = _backbone_model_table({"fits": False, "reason": "damping chi-square 240 (limit 9.2)"})
+    assert t["rows"] == [] and "damping chi-square 240" in t["caption"] and "No weakly nonlinear model" in t["caption"]
+    ok = {"fits": True, "fn0_hz": 10.0, "fn0_std_hz": 0.0012, "k3_over_k": 0.05, "k3_over_k_std": 0.0031,
+          "zeta_viscous": 0.0104, "zeta_viscous_std": 0.00021, "friction_term": 1e-5, "friction_term_std": 2e-5,
+          "quadratic_term": 0.0, "quadratic_term_std": 1e-3}
+    rows = _backbone_model_table(ok)["rows"]
+    assert rows[0][1:] == ["10.0000", "0.0012"] and rows[2][1:] == ["0.01040", "0.00021"]

@@ -52,9 +52,9 @@ def run(args, out, err) -> int:
             est = rd.ringdown(rec, channel=args.channel, band=band)
         cmp = compare(est, pred, rtol_fn=args.rtol_fn)
         if args.plot:
-            ax = plot_module().plot_comparison(cmp, rtol_fn=args.rtol_fn,
-                                               against="baseline" if args.baseline else "model")
-            save_figure(ax.figure, args.plot)
+            fig = plot_module().plot_comparison(cmp, rtol_fn=args.rtol_fn,
+                                                against="baseline" if args.baseline else "model")
+            save_figure(fig, args.plot)
     if args.json:
         emit_json({"command": "compare", "file": str(args.file), **cmp.to_dict(),
                    "measured": est.to_dict()["modes"], "warnings": msgs}, out)

@@ -48,8 +48,7 @@ def run(args, out, err) -> int:
                         foundation=args.foundation, channel=primary, line_frequency=args.line_frequency,
                         prewhitening=tuple(args.prewhitening), tach=args.tach, pulses_per_rev=args.pulses_per_rev)
     if args.plot:
-        axes = plot_module().plot_diagnosis(rec, diag)
-        save_figure(axes[0].figure, args.plot)
+        save_figure(plot_module().plot_diagnosis(rec, diag), args.plot)
     print_warnings(msgs, err)
     if args.json:
         emit_json({"command": "diagnose", "file": str(args.file), **diag.to_dict(), "warnings": msgs}, out)

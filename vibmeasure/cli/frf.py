@@ -60,9 +60,9 @@ def run(args, out, err) -> int:
         if args.plot:
             plot = plot_module()
             if est is not None:
-                fig = plot.plot_stabilisation(est, frf=frf).figure
+                fig = plot.plot_stabilisation(est, frf=frf)
             else:
-                fig = plot.plot_frf(frf)[0].figure
+                fig = plot.plot_frf(frf)
             save_figure(fig, args.plot)
     if args.csv:
         _frf_csv(args.csv, frf, est)

@@ -63,7 +63,7 @@ def run(args, out, err) -> int:
     print_warnings(msgs, err)
     if args.plot:
         pm = plot_module()
-        ax = pm.plot_singular_values(est) if args.method == "fdd" else pm.plot_stabilisation(est)
-        save_figure(ax.figure, args.plot)
+        fig = pm.plot_singular_values(est) if args.method == "fdd" else pm.plot_stabilisation(est)
+        save_figure(fig, args.plot)
         print(f"vibmeasure: wrote {args.plot}", file=err)
     return 0

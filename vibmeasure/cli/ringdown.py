@@ -79,8 +79,7 @@ def _ringdown(args, out, err=None):
     return rec, est
 
 def _save_plot(path, rec, est):
-    ax, _ = plot_module().plot_ringdown(rec, est)
-    save_figure(ax.figure, path)
+    save_figure(plot_module().plot_ringdown(rec, est), path)
 
 def _report_text(args, rec, est, out):
     ch = est.extras.get("channel", "")

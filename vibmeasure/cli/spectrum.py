@@ -104,7 +104,7 @@ def _spectrum_outputs(args, spec, found, band):
             df = df[(df.freq_hz >= band[0]) & (df.freq_hz <= band[1])]
         write_table(df, args.csv, {c: spec.unit for c in spec.channels})
     if args.plot:
-        ax = plot_module().plot_spectrum(spec, peaks=found or None)   # every channel's, in its colour
+        fig = plot_module().plot_spectrum(spec, peaks=found or None)   # every channel's, in its colour
         if band:
-            ax.set_xlim(*band)
-        save_figure(ax.figure, args.plot)
+            fig.panels[0].set_xlim(*band)
+        save_figure(fig, args.plot)

@@ -69,7 +69,6 @@ def run(args, out, err) -> int:
         for j in range(0, sp.fn.size, max(1, sp.fn.size // 24)):
             print(f"  {sp.fn[j]:10.4g}  " + "  ".join(f"{v[j]:12.4g}" for v in sp.values.values()), file=out)
     if args.plot:
-        ax = plot_module().plot_srs(sp)
-        save_figure(ax.figure, args.plot)
+        save_figure(plot_module().plot_srs(sp), args.plot)
     print_written(args, err)
     return 0

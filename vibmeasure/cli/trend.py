@@ -41,8 +41,8 @@ def run(args, out, err) -> int:
         if drawn.empty:
             raise VibMeasureError("nothing to plot: no metric has a baseline yet")
         r = drawn.iloc[0]
-        ax = plot_module().plot_trend(args.store, asset=r["asset"], point=r["point"], metric=r["metric"],
-                                      task=r["task"], baseline_count=args.baseline)
-        save_figure(ax.figure, args.plot)
+        fig = plot_module().plot_trend(args.store, asset=r["asset"], point=r["point"], metric=r["metric"],
+                                       task=r["task"], baseline_count=args.baseline)
+        save_figure(fig, args.plot)
         print(f"vibmeasure: wrote {args.plot}", file=err)
     return 0

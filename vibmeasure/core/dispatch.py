@@ -153,8 +153,8 @@ def load_input(item, *, fs=None, unit=None, channels=None, input=None):
         from .. import io
         rec, name = io.read(item, fs=fs, unit=unit), Path(item).name
     else:
-        raise ParameterError(f"an input must be a file path or a vm.Record, got {type(item).__name__} (a result "
-                             "is reported from the record it came from: pass the record)")
+        raise ParameterError(f"an input must be a file path or a vm.Record, got {type(item).__name__} (vm.report "
+                             "also takes a ModalEstimate, Diagnosis or Comparison, alone or as (record, result))")
     if channels is not None:
         keep = [channels] if isinstance(channels, str) else list(channels)
         if input is not None and input not in keep:

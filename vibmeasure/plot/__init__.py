@@ -1,7 +1,8 @@
 """Pictures of records and results (with report/, the only code that imports matplotlib).
 
-Each function draws a result it is given on the given axes (or new ones) and returns them; nothing is
-computed here beyond what drawing needs. One module per kind of result.
+Each function draws a result it is given on the given axes (or new ones) and returns the Figure, its
+axes in ``fig.panels`` (``_figure.PanelFigure``); nothing is computed here beyond what drawing needs.
+One module per kind of result.
 """
 
 from .decay import decay_model, plot_backbone, plot_ringdown

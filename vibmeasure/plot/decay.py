@@ -8,7 +8,10 @@ from ..core._validate import response_channel
 from ..core.errors import ParameterError
 from ..core.record import Record
 from ..core.results import ModalEstimate
+from ..core.results._common import shown_flags
+from ..core.rounding import with_std
 from ..plotstyle import COLORS
+from ._figure import new_figure
 from ._style import _styled
 
 
@@ -69,8 +72,9 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
 
     Returns
     -------
-    tuple of matplotlib.axes.Axes
-        (signal, residual).
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (signal, residual) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -85,9 +89,10 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
     >>> import vibmeasure as vm
     >>> from vibmeasure import plot
     >>> rec = vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=4.0, snr_db=40, seed=1)
-    >>> ax, axr = plot.plot_ringdown(rec, vm.ringdown(rec))
+    >>> fig = plot.plot_ringdown(rec, vm.ringdown(rec))
+    >>> [ax.get_xlabel() for ax in fig.panels]
+    ['', 'time [s]']
     """
-    import matplotlib.pyplot as plt
     if not isinstance(rec, Record):
         raise ParameterError(f"rec must be a vm.Record, got {type(rec).__name__}")
     if not isinstance(est, ModalEstimate):
@@ -97,7 +102,7 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
     x = np.asarray(rec.data[idx], float)
     t = rec.time
     if axes is None:
-        fig, axes = plt.subplots(2, 1, sharex=True, figsize=(9, 5.5), gridspec_kw={"height_ratios": [3, 1]})
+        fig, axes = new_figure(2, 1, sharex=True, figsize=(9, 5.5), gridspec_kw={"height_ratios": [3, 1]})
     ax, axr = axes
     c = rec.channels[idx]
     band = est.extras.get("band_hz")
@@ -142,11 +147,14 @@ def plot_ringdown(rec: Record, est: ModalEstimate, *, channel=None, axes=None):
                 if r.size:
                     axr.set_ylim(-1.3 * r.max(), 1.3 * r.max())
     ax.axvline(t0, color="k", lw=0.6, ls=":")
-    lines = [f"{fn:.5g} Hz, zeta {z:.4g}" + (f" ± {zs:.2g}" if np.isfinite(zs) else "")
-             for fn, z, zs in zip(est.fn, est.zeta, est.zeta_std)]
+    nan = np.full(est.n_modes, np.nan)
+    fn_std, zeta_std = (nan if s is None else s for s in (est.fn_std, est.zeta_std))
+    lines = [f"{with_std(fn, fs_)[0]} Hz, zeta " + " ± ".join(v for v in with_std(z, zs) if v != "n/a")
+             for fn, fs_, z, zs in zip(est.fn, fn_std, est.zeta, zeta_std)]
     title = f"{est.method}: " + "; ".join(lines[:4]) + (" ..." if len(lines) > 4 else "")
-    if est.flags:
-        title += "\nflags: " + ", ".join(est.flags)
+    flags = shown_flags(est.flags, est.mode_flags)   # the report's flag table lists the same ones
+    if flags:
+        title += "\nflags: " + ", ".join(flags)
     ax.set_title(title, fontsize=9)
     what = c.quantity if c.quantity not in ("unknown", "", None) else c.name
     ax.set_ylabel(f"{what} [{c.unit or '-'}]")
@@ -171,8 +179,9 @@ def plot_backbone(est: ModalEstimate, *, mode: int = 0, axes=None):
 
     Returns
     -------
-    numpy.ndarray of matplotlib.axes.Axes
-        (fn, zeta).
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (fn, zeta) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -187,15 +196,14 @@ def plot_backbone(est: ModalEstimate, *, mode: int = 0, axes=None):
     >>> import vibmeasure as vm
     >>> from vibmeasure import plot
     >>> rec = vm.synth.free_decay(fn=10.0, zeta=0.01, fs=500.0, duration=20.0, snr_db=50, seed=1)
-    >>> axes = plot.plot_backbone(vm.ringdown(rec))
+    >>> fig = plot.plot_backbone(vm.ringdown(rec))
     """
-    import matplotlib.pyplot as plt
     bb = est.extras.get("backbone")
     if bb is None or len(bb) == 0 or mode not in set(bb["mode"]):
         raise ParameterError(f"mode={mode} has no backbone in this estimate (too few cycles above the noise)")
     b = bb[bb["mode"] == mode]
     if axes is None:
-        _, axes = plt.subplots(1, 2, figsize=(9, 3.5), constrained_layout=True)
+        _, axes = new_figure(1, 2, figsize=(9, 3.5), constrained_layout=True)
     unit = est.unit or "-"
     A = b["amplitude"].to_numpy(float)
     axes[0].errorbar(A, b["fn_hz"], yerr=b["fn_std_hz"], fmt="o", ms=3, lw=1, label="windows")

@@ -59,8 +59,8 @@ def save_figure(fig, path, *, dpi: int = 120) -> None:
     >>> import vibmeasure as vm
     >>> from vibmeasure import plot
     >>> import tempfile, pathlib
-    >>> ax = plot.plot_mac(vm.mac(np.eye(2)))
-    >>> plot.save_figure(ax.figure, pathlib.Path(tempfile.mkdtemp()) / "mac.png")
+    >>> fig = plot.plot_mac(vm.mac(np.eye(2)))
+    >>> plot.save_figure(fig, pathlib.Path(tempfile.mkdtemp()) / "mac.png")
     """
     from pathlib import Path
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.labels import label
+from ._figure import PanelFigure, new_figure
 from ._style import _styled
 
 
@@ -28,8 +29,9 @@ def plot_diagnosis(rec, diag, *, axes=None):
 
     Returns
     -------
-    tuple of matplotlib.axes.Axes
-        (envelope, spectrum, gauge, kurtogram).
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (envelope, spectrum, gauge, kurtogram) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -44,13 +46,13 @@ def plot_diagnosis(rec, diag, *, axes=None):
     >>> import vibmeasure as vm
     >>> from vibmeasure import plot
     >>> rec = vm.synth.machine(fault="bearing_outer_race", rpm=1797, duration=2.0, seed=1)
-    >>> axes = plot.plot_diagnosis(rec, vm.diagnose(rec, rpm=1797, bearing="6205-2RS"))
+    >>> fig = plot.plot_diagnosis(rec, vm.diagnose(rec, rpm=1797, bearing="6205-2RS"))
     """
     import matplotlib.pyplot as plt
 
     from ..signal.spectral import amplitude_spectrum
     if axes is None:
-        fig = plt.figure(figsize=(12, 8), layout="constrained")
+        fig = plt.figure(figsize=(12, 8), layout="constrained", FigureClass=PanelFigure)
         gs = fig.add_gridspec(3, 5, height_ratios=(1.2, 1, 1))
         axes = (fig.add_subplot(gs[0, :4]), fig.add_subplot(gs[2, :4]), fig.add_subplot(gs[:, 4]),
                 fig.add_subplot(gs[1, :4]))
@@ -245,7 +247,9 @@ def plot_trend(store, *, asset: str, point: str, metric: str, task: str | None =
 
     Returns
     -------
-    matplotlib.axes.Axes
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (trend,) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -265,14 +269,13 @@ def plot_trend(store, *, asset: str, point: str, metric: str, task: str | None =
     >>> with warnings.catch_warnings():
     ...     warnings.simplefilter("ignore")
     ...     _ = vm.batch(task="diagnose", store=folder / "s.h5", manifest=folder / "fleet" / "machines.csv")
-    >>> ax = plot.plot_trend(folder / "s.h5", asset="pump-3", point="DE", metric="velocity_rms_mm_s", baseline_count=3)
+    >>> fig = plot.plot_trend(folder / "s.h5", asset="pump-3", point="DE", metric="velocity_rms_mm_s", baseline_count=3)
     """
-    import matplotlib.pyplot as plt
 
     from ..monitor.trend import metric_history
     df, r = metric_history(store, asset=asset, point=point, metric=metric, task=task, baseline_count=baseline_count)
     if ax is None:
-        _, ax = plt.subplots(figsize=(8, 3.5))
+        _, ax = new_figure(figsize=(8, 3.5))
     ax.plot(df["time"], df[metric].astype(float), "o-", ms=3, lw=1, color="C0", label=label(metric))
     if r is not None:
         mu, sd = r["baseline_mean"], r["baseline_std"]

@@ -7,6 +7,7 @@ import numpy as np
 from ..core._validate import name_index
 from ..core.errors import ParameterError
 from ..plotstyle import COLORS
+from ._figure import new_figure
 from ._style import _styled
 
 
@@ -28,8 +29,9 @@ def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
 
     Returns
     -------
-    tuple of matplotlib.axes.Axes
-        (magnitude, phase, coherence).
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (magnitude, phase, coherence) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -44,9 +46,8 @@ def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
     >>> import vibmeasure as vm
     >>> from vibmeasure import plot
     >>> h = vm.synth.modal_frf(np.linspace(1, 100, 500), fn=[30.0], zeta=[0.02], shapes=[[1.0]])
-    >>> axes = plot.plot_frf(h)
+    >>> fig = plot.plot_frf(h)
     """
-    import matplotlib.pyplot as plt
 
     from ..core.results import FRF
     if not isinstance(frf, FRF):
@@ -54,7 +55,7 @@ def plot_frf(frf, *, est=None, output=0, input=0, axes=None):
     o = name_index(frf.outputs, output, what="output")
     i = name_index(frf.inputs, input, what="input")
     if axes is None:
-        fig, axes = plt.subplots(3, 1, sharex=True, figsize=(9, 7), gridspec_kw={"height_ratios": [3, 1.5, 1]})
+        fig, axes = new_figure(3, 1, sharex=True, figsize=(9, 7), gridspec_kw={"height_ratios": [3, 1.5, 1]})
     am, ap, ac = axes
     h = frf.h[o, i]
     am.semilogy(frf.freq, np.abs(h), lw=0.8, color=COLORS["measured"], label=f"{frf.outputs[o]}/{frf.inputs[i]} ({frf.estimator or 'data'})")
@@ -106,7 +107,9 @@ def plot_nyquist(frf, *, output=0, input=0, band=None, ax=None):
 
     Returns
     -------
-    matplotlib.axes.Axes
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (nyquist,) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -121,11 +124,10 @@ def plot_nyquist(frf, *, output=0, input=0, band=None, ax=None):
     >>> import vibmeasure as vm
     >>> from vibmeasure import plot
     >>> h = vm.synth.modal_frf(np.linspace(1, 100, 500), fn=[30.0], zeta=[0.02], shapes=[[1.0]])
-    >>> ax = plot.plot_nyquist(h, band=(25, 35))
+    >>> fig = plot.plot_nyquist(h, band=(25, 35))
     """
-    import matplotlib.pyplot as plt
     if ax is None:
-        _, ax = plt.subplots(figsize=(5.5, 5.5))
+        _, ax = new_figure(figsize=(5.5, 5.5))
     o = name_index(frf.outputs, output, what="output")
     i = name_index(frf.inputs, input, what="input")
     sel = np.ones(frf.freq.size, bool) if band is None else (frf.freq >= band[0]) & (frf.freq <= band[1])
@@ -157,7 +159,9 @@ def plot_stabilisation(est, *, frf=None, ax=None):
 
     Returns
     -------
-    matplotlib.axes.Axes
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (stabilisation,) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -172,13 +176,12 @@ def plot_stabilisation(est, *, frf=None, ax=None):
     >>> import vibmeasure as vm
     >>> from vibmeasure import plot
     >>> h = vm.synth.modal_frf(np.linspace(1, 100, 1000), fn=[30.0], zeta=[0.02], shapes=[[1.0]])
-    >>> ax = plot.plot_stabilisation(vm.fit_modes(h, band=(10, 60)), frf=h)
+    >>> fig = plot.plot_stabilisation(vm.fit_modes(h, band=(10, 60)), frf=h)
     """
-    import matplotlib.pyplot as plt
     if "stabilisation" not in est.extras:
         raise ParameterError("est must come from vm.fit_modes or vm.oma_ssi (it carries the stabilisation table)")
     if ax is None:
-        _, ax = plt.subplots(figsize=(9, 5), layout="constrained")
+        _, ax = new_figure(figsize=(9, 5), layout="constrained")
     tab = est.extras["stabilisation"]
     oma = est.method == "oma_ssi"
     style = {"o": dict(marker="o", color="0.7", ms=3, ls=""), "f": dict(marker="d", color="C1", ms=3, ls=""),
@@ -228,7 +231,9 @@ def plot_mac(matrix, *, labels=None, ax=None):
 
     Returns
     -------
-    matplotlib.axes.Axes
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (mac,) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -242,12 +247,11 @@ def plot_mac(matrix, *, labels=None, ax=None):
     >>> import numpy as np
     >>> import vibmeasure as vm
     >>> from vibmeasure import plot
-    >>> ax = plot.plot_mac(vm.mac(np.eye(3)))
+    >>> fig = plot.plot_mac(vm.mac(np.eye(3)))
     """
-    import matplotlib.pyplot as plt
     m = np.asarray(matrix, float)
     if ax is None:
-        _, ax = plt.subplots(figsize=(4.5, 4))
+        _, ax = new_figure(figsize=(4.5, 4))
     ax.grid(False)  # no grid lines across an image
     im = ax.imshow(m, vmin=0, vmax=1, cmap="Blues")
     for (r, c), v in np.ndenumerate(m):
@@ -282,8 +286,9 @@ def plot_comparison(cmp, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.5, again
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The fn axes.
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (fn, zeta) on a new figure, (fn,) on given axes (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -299,15 +304,14 @@ def plot_comparison(cmp, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.5, again
     >>> from vibmeasure import plot
     >>> est = vm.ringdown(vm.synth.free_decay(fn=10.0, zeta=0.02, fs=500.0, duration=8.0, snr_db=40, seed=1))
     >>> cmp = vm.compare(est, vm.models.SDOF(m=1.0, k=(2 * np.pi * 10.1) ** 2, zeta=0.02))
-    >>> ax = plot.plot_comparison(cmp)
+    >>> fig = plot.plot_comparison(cmp)
     """
-    import matplotlib.pyplot as plt
 
     from ..core._validate import positive
     rtol_fn, rtol_zeta = positive(rtol_fn, "rtol_fn"), positive(rtol_zeta, "rtol_zeta")
     ax_z = None
     if ax is None:
-        _, (ax, ax_z) = plt.subplots(1, 2, figsize=(10, 4), width_ratios=(3, 2))
+        _, (ax, ax_z) = new_figure(1, 2, figsize=(10, 4), width_ratios=(3, 2))
     colors = {"ok": COLORS["ok"], "watch": COLORS["watch"], "alarm": COLORS["alarm"]}
     labels = [f"{r['fn_predicted_hz']:.4g} Hz" for r in cmp.rows]
 
@@ -329,7 +333,7 @@ def plot_comparison(cmp, *, rtol_fn: float = 0.02, rtol_zeta: float = 0.5, again
     if ax_z is not None:
         bars(ax_z, "zeta", rtol_zeta, "zeta")
         ax_z.set_title("damping ratio")
-    return ax
+    return ax if ax_z is None else (ax, ax_z)
 
 
 @_styled
@@ -348,7 +352,9 @@ def plot_singular_values(est, *, ax=None, n: int | None = None):
 
     Returns
     -------
-    matplotlib.axes.Axes
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (singular values,) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -364,13 +370,12 @@ def plot_singular_values(est, *, ax=None, n: int | None = None):
     >>> from vibmeasure import plot
     >>> chain = vm.models.MDOF(np.eye(2), np.array([[2e4, -1e4], [-1e4, 1e4]]), modal_zeta=[0.02, 0.02])
     >>> est = vm.oma_fdd(vm.synth.ambient(chain, fs=100.0, duration=300.0, seed=1), band=(1, 40))
-    >>> ax = plot.plot_singular_values(est)
+    >>> fig = plot.plot_singular_values(est)
     """
-    import matplotlib.pyplot as plt
     if "singular_values" not in est.extras:
         raise ParameterError("est must come from vm.oma_fdd (it carries the singular values)")
     if ax is None:
-        _, ax = plt.subplots(figsize=(9, 4.5), layout="constrained")
+        _, ax = new_figure(figsize=(9, 4.5), layout="constrained")
     sv = est.extras["singular_values"]
     vals = np.asarray(sv["values"])
     for j in range(vals.shape[0] if n is None else min(n, vals.shape[0])):

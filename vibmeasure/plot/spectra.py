@@ -7,6 +7,7 @@ import numpy as np
 from ..core._validate import name_index
 from ..core.errors import ParameterError
 from ..plotstyle import ANNOTATION_SIZE, COLORS
+from ._figure import new_figure
 from ._style import _styled
 
 
@@ -38,7 +39,9 @@ def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: b
 
     Returns
     -------
-    matplotlib.axes.Axes
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (spectrum,) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -54,9 +57,8 @@ def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: b
     >>> from vibmeasure import plot
     >>> rec = vm.synth.machine(rpm=1797, duration=1.0, seed=1)
     >>> spec = vm.amplitude_spectrum(rec)
-    >>> ax = plot.plot_spectrum(spec, peaks=vm.pick_peaks(spec, n=5), lines={"1X": 29.95})
+    >>> fig = plot.plot_spectrum(spec, peaks=vm.pick_peaks(spec, n=5), lines={"1X": 29.95})
     """
-    import matplotlib.pyplot as plt
 
     from ..core.results import Spectrum
     if not isinstance(spec, Spectrum):
@@ -70,7 +72,7 @@ def plot_spectrum(spec, *, ax=None, channel=None, peaks=None, lines=None, log: b
     if not isinstance(db, (bool, np.bool_)):
         raise ParameterError(f"db={db!r} must be True or False")
     if ax is None:
-        _, ax = plt.subplots(figsize=(9, 4.5))
+        _, ax = new_figure(figsize=(9, 4.5))
     rows = range(spec.n_channels) if channel is None else [name_index(spec.channels, channel)]
     power = spec.kind in ("psd", "power")
 
@@ -184,7 +186,9 @@ def plot_srs(spec, *, ax=None, tripartite: bool | None = None):
 
     Returns
     -------
-    matplotlib.axes.Axes
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (srs,) (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -200,11 +204,10 @@ def plot_srs(spec, *, ax=None, tripartite: bool | None = None):
     >>> from vibmeasure import plot
     >>> t = np.arange(1000) / 20000.0
     >>> sp = vm.srs(vm.Record.from_array(np.where(t < 0.002, 50 * np.sin(np.pi * t / 0.002), 0.0), fs=20000.0, unit="g"))
-    >>> ax = plot.plot_srs(sp)
+    >>> fig = plot.plot_srs(sp)
     """
-    import matplotlib.pyplot as plt
     if ax is None:
-        _, ax = plt.subplots(figsize=(7, 5.5), layout="constrained")
+        _, ax = new_figure(figsize=(7, 5.5), layout="constrained")
     tri = spec.output == "pseudo_velocity" if tripartite is None else bool(tripartite)
     w = 2 * np.pi * spec.fn
     span = []
@@ -256,8 +259,9 @@ def plot_transmissibility(tr, *, ax=None):
 
     Returns
     -------
-    matplotlib.axes.Axes
-        The |T| axes.
+    matplotlib.figure.Figure
+        The figure drawn on; ``fig.panels`` holds its axes (|T|, coherence) on a new figure, (|T|,) on given axes (the figure unpacks
+        into them).
 
     Raises
     ------
@@ -273,11 +277,10 @@ def plot_transmissibility(tr, *, ax=None):
     >>> from vibmeasure import plot
     >>> iso = vm.models.SDOF(m=1.0, k=3948.0, zeta=0.05)
     >>> tr = vm.transmissibility(vm.synth.base_excited(iso, fs=500.0, duration=30.0, seed=1), base="base", top="top")
-    >>> ax = plot.plot_transmissibility(tr)
+    >>> fig = plot.plot_transmissibility(tr)
     """
-    import matplotlib.pyplot as plt
     if ax is None:
-        fig, (ax, axc) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, height_ratios=(3, 1), layout="constrained")
+        fig, (ax, axc) = new_figure(2, 1, figsize=(8, 6), sharex=True, height_ratios=(3, 1), layout="constrained")
     else:
         axc = None
     ax.loglog(tr.freq, tr.magnitude, lw=1.0, label=f"measured {tr.top}/{tr.base}")
@@ -296,4 +299,4 @@ def plot_transmissibility(tr, *, ax=None):
         axc.set_xlabel("frequency [Hz]")
     else:
         ax.set_xlabel("frequency [Hz]")
-    return ax
+    return ax if axc is None else (ax, axc)

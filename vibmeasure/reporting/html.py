@@ -11,6 +11,7 @@ import numpy as np
 from ..core.dispatch import analysis_for
 from ..core.errors import ParameterError, VibMeasureError
 from ..io._common import file_sha256
+from .given import is_result, result_sections
 from .sections import (comparison_section, diagnosis_section, error_section, fleet_section, modes_section,
                        ringdown_section)
 
@@ -89,8 +90,11 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
 
     Parameters
     ----------
-    inputs : sequence of str, os.PathLike or Record
-        Record files and/or records (a single one is taken as a list of one).
+    inputs : sequence of str, os.PathLike, Record or result
+        Record files and/or records, each analysed by what it holds; and/or results computed already
+        (a ModalEstimate, Diagnosis or Comparison), reported as they are, alone or paired with their
+        source for the figures: ``(record, estimate)``, ``(record, diagnosis)``, ``(frf, estimate)``.
+        A single one is taken as a list of one.
     out : str or os.PathLike
         The HTML file.
     store : str, os.PathLike or Store, optional
@@ -137,6 +141,9 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
     >>> _ = vm.write(folder / "decay.h5", vm.synth.free_decay(fn=12.0, zeta=0.02, fs=500.0, duration=6.0, seed=1))
     >>> vm.report([folder / "decay.h5"], folder / "r.html").suffix
     '.html'
+    >>> rec = vm.synth.free_decay(fn=20.0, zeta=0.01, fs=1000.0, duration=4.0, seed=2)
+    >>> vm.report([(rec, vm.ringdown(rec))], folder / "given.html").name   # a result computed already
+    'given.html'
     """
     import jinja2
     import scipy
@@ -148,22 +155,25 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
     if not out.parent.exists():
         raise ParameterError(f"out={str(out)!r}: folder {str(out.parent)!r} does not exist")
     from ..core.record import Record
-    if isinstance(inputs, (str, Path, Record)):
+    if isinstance(inputs, (str, Path, Record)) or is_result(inputs):
         inputs = [inputs]
     file_backend()
     sections, prov = [], []
-    for p in inputs:
-        label = str(p.meta.get("source") or "record") if isinstance(p, Record) else Path(str(p)).name
+    for i, p in enumerate(inputs):
+        label = _label(p, i)
         try:
-            secs, row = analyse_input(p, rpm=rpm, bearing=bearing, band=band, model=model, fs=fs, unit=unit,
-                                      channels=channels, input=input)
+            if is_result(p):   # computed already: reported as it is, never analysed again
+                secs, row = result_sections(p, i)
+            else:
+                secs, row = analyse_input(p, rpm=rpm, bearing=bearing, band=band, model=model, fs=fs, unit=unit,
+                                          channels=channels, input=input)
             sections += secs
             prov.append(row)
         except Exception as exc:   # noqa: BLE001 - one input's failure is its section, never the report's
             sections.append(error_section(label, exc))
             if failures is not None:
-                failures.append((label if isinstance(p, Record) else str(p), f"{type(exc).__name__}: {str(exc)[:300]}"))
-            prov.append({"input": label, "sha256": _sha(p), "method": "not analysed"})
+                failures.append((str(p) if isinstance(p, (str, Path)) else label, f"{type(exc).__name__}: {str(exc)[:300]}"))
+            prov.append({"input": label, "sha256": "(result)" if is_result(p) else _sha(p), "method": "not analysed"})
     if store is not None:
         try:
             name, digest = _store_provenance(store)
@@ -184,6 +194,16 @@ def report(inputs=(), out="report.html", *, store=None, title: str = "Vibration 
     with atomic_path(out) as tmp:
         tmp.write_text(html, encoding="utf-8")
     return out
+
+
+def _label(item, i: int) -> str:
+    """How an input is named on the page: a record's source, a result's kind, a file's name."""
+    from ..core.record import Record
+    if isinstance(item, Record):
+        return str(item.meta.get("source") or "record")
+    if is_result(item) or not isinstance(item, (str, Path)):
+        return f"{type(item).__name__} (input {i + 1})"
+    return Path(str(item)).name
 
 
 def _store_provenance(store) -> tuple[str, str]:

@@ -8,6 +8,7 @@ import io as _io
 import numpy as np
 
 from ..core.results import FLAG_TEXT
+from ..core.results._common import shown_flags
 from ..core.labels import label
 from ..core.rounding import band, plain, with_std
 
@@ -44,6 +45,12 @@ FLAG_ADVICE = {
 }
 
 
+# how each estimator's method name reads in a table caption
+METHOD_TEXT = {"ml": "maximum likelihood", "fit_modes": "LSCF + maximum likelihood", "oma_ssi": "covariance SSI",
+               "oma_fdd": "enhanced FDD", "halfpower": "half-power bandwidth", "circle": "circle fit",
+               "baseline": "baseline"}
+
+
 def _svg(fig) -> str:
     import matplotlib.pyplot as plt
     buf = _io.StringIO()
@@ -68,15 +75,10 @@ def _pm(value, std) -> list:
     return list(with_std(value, std))
 
 
-def _flags(flags) -> list[dict]:
-    out, seen = [], set()
-    for f in flags:
-        if f in seen or f in ("noise_floor",):
-            continue
-        seen.add(f)
-        out.append({"flag": f, "text": FLAG_TEXT.get(f, f),
-                    "advice": FLAG_ADVICE.get(f, "see the documentation of the flag")})
-    return out
+def _flags(flags, mode_flags=None) -> list[dict]:
+    """Each flag shown (``shown_flags``: the same list the result's plot shows) with its text and advice."""
+    return [{"flag": f, "text": FLAG_TEXT.get(f, f), "advice": FLAG_ADVICE.get(f, "see the documentation of the flag")}
+            for f in shown_flags(flags, mode_flags)]
 
 
 def _mode_table(est, caption):
@@ -89,17 +91,20 @@ def _mode_table(est, caption):
 
 # --- sections -------------------------------------------------------------------------------------
 def ringdown_section(rec, est, name):
+    """A ring-down (or any time-domain damping) estimate: its modes, flags, the record with the fitted
+    decay (when ``rec`` is given) and the strongest mode's backbone."""
     from .. import plot
-    mf = [f for m in est.mode_flags for f in m] if est.mode_flags else []
+    how = METHOD_TEXT.get(est.method, est.method)
     sec = {"kind": "ringdown", "title": f"Ring-down: {name}", "tables": [_mode_table(est, "Natural frequencies and "
-                                                                                       "damping (maximum likelihood)")],
-           "flags": _flags(list(est.flags) + mf), "figures": []}
+                                                                                       f"damping ({how})")],
+           "flags": _flags(est.flags, est.mode_flags), "figures": []}
     k = int(np.argmax(est.amplitude)) if est.amplitude is not None and est.n_modes else 0
     fn_k, zeta_k = with_std(est.fn[k], est.fn_std[k])[0], with_std(est.zeta[k], est.zeta_std[k])[0]
     sec["verdict"], sec["verdict_class"] = f"fn {fn_k} Hz, zeta {zeta_k}", "ok"
     sec["verdict_text"] = f"(strongest of {est.n_modes} mode(s); channel {est.extras.get('channel', '')})"
-    ax, _ = plot.plot_ringdown(rec, est)
-    sec["figures"].append({"svg": _svg(ax.figure), "caption": "record, fitted decay and envelope; residual below"})
+    if rec is not None and est.method == "ml":
+        sec["figures"].append({"svg": _svg(plot.plot_ringdown(rec, est)),
+                               "caption": "record, fitted decay and envelope; residual below"})
     bb = est.extras.get("backbone")
     if bb is not None and len(bb) and k in set(bb["mode"]):
         b = bb[bb["mode"] == k]
@@ -108,17 +113,41 @@ def ringdown_section(rec, est, name):
                               "header": ["amplitude", "fn [Hz]", "± std", "zeta", "± std"],
                               "rows": [[_fmt(r.amplitude, 4), *_pm(r.fn_hz, r.fn_std_hz), *_pm(r.zeta, r.zeta_std)]
                                        for r in b.itertuples()]})
-        axes = plot.plot_backbone(est, mode=k)
-        sec["figures"].append({"svg": _svg(axes[0].figure), "caption": "damping and frequency versus amplitude"})
+        sec["tables"].append(_backbone_model_table(est.extras.get("backbone_model", {}).get(k)))
+        sec["figures"].append({"svg": _svg(plot.plot_backbone(est, mode=k)),
+                               "caption": "damping and frequency versus amplitude"})
     return sec
 
 
+_MODEL_ROWS = (("natural frequency at zero amplitude fn0 [Hz]", "fn0_hz", "fn0_std_hz"),
+               ("cubic stiffness k3/k [1/unit^2]", "k3_over_k", "k3_over_k_std"),
+               ("viscous damping ratio zeta_v [-]", "zeta_viscous", "zeta_viscous_std"),
+               ("friction term [unit]", "friction_term", "friction_term_std"),
+               ("quadratic damping term [1/unit]", "quadratic_term", "quadratic_term_std"))
+
+
+def _backbone_model_table(model) -> dict:
+    """The weakly nonlinear model fitted to the backbone, or, when it fails its goodness-of-fit test,
+    a table that says so and why: the windows then stand alone and no model number is printed."""
+    head = ["parameter", "value", "± std"]
+    if not model:
+        return {"caption": "No backbone model: too few windows", "header": head, "rows": []}
+    if not model.get("fits", False):
+        return {"caption": "No weakly nonlinear model (Duffing stiffness; viscous, friction and quadratic damping) "
+                           f"describes these windows: {model.get('reason') or 'lack of fit'}. Quote the windows "
+                           "above with their amplitudes, not a model parameter.", "header": head, "rows": []}
+    return {"caption": "Weakly nonlinear model of the backbone (fits the windows within their std)", "header": head,
+            "rows": [[what, *_pm(model[key], model[std])] for what, key, std in _MODEL_ROWS]}
+
+
 def modes_section(frf, est, name):
+    """Modes from FRFs (fit_modes) or from the outputs alone (oma_ssi, oma_fdd): the modes, the poles
+    refused, the FRF with the synthesis (when ``frf`` is given) and the stabilisation diagram."""
     from .. import plot
-    mf = [f for m in est.mode_flags for f in m] if est.mode_flags else []
-    sec = {"kind": "modes", "title": f"FRF and modes: {name}", "tables": [_mode_table(est, "Modes (LSCF + maximum "
-                                                                                         "likelihood)")],
-           "flags": _flags(list(est.flags) + mf), "figures": []}
+    how = METHOD_TEXT.get(est.method, est.method)
+    sec = {"kind": "modes", "title": f"{'FRF and modes' if frf is not None else 'Modes'}: {name}",
+           "tables": [_mode_table(est, f"Modes ({how})")],
+           "flags": _flags(est.flags, est.mode_flags), "figures": []}
     rej = est.extras.get("rejected_modes") or []
     if rej:
         sec["tables"].append({"caption": "Poles the data does not support (not reported as modes)",
@@ -126,11 +155,14 @@ def modes_section(frf, est, name):
                               "rows": [[_fmt(d["fn_hz"], 6), _fmt(d["zeta"], 3), d["reason"]] for d in rej]})
     sec["verdict"], sec["verdict_class"] = f"{est.n_modes} mode(s)", "ok"
     sec["verdict_text"] = "in " + band(*est.extras["band_hz"]) + " Hz" if est.extras.get("band_hz") else ""
-    axes = plot.plot_frf(frf, est=est)
-    sec["figures"].append({"svg": _svg(axes[0].figure), "caption": "FRF magnitude, phase and coherence with the "
-                                                                   "modal synthesis"})
-    ax = plot.plot_stabilisation(est, frf=frf)
-    sec["figures"].append({"svg": _svg(ax.figure), "caption": "stabilisation diagram"})
+    if frf is not None:
+        sec["figures"].append({"svg": _svg(plot.plot_frf(frf, est=est)),
+                               "caption": "FRF magnitude, phase and coherence with the modal synthesis"})
+    if est.method == "oma_fdd":
+        sec["figures"].append({"svg": _svg(plot.plot_singular_values(est)),
+                               "caption": "singular values of the outputs' spectral matrix"})
+    elif est.method in ("fit_modes", "oma_ssi"):
+        sec["figures"].append({"svg": _svg(plot.plot_stabilisation(est, frf=frf)), "caption": "stabilisation diagram"})
     return sec
 
 
@@ -160,9 +192,9 @@ def diagnosis_section(rec, diag, name):
                           "rows": [[_fmt(sev.get("velocity_rms_mm_s"), 3),
                                     band(*sev["band_hz"]) if sev.get("band_hz") else "",
                                     sev.get("group"), sev.get("foundation"), sev.get("zone")]]})
-    axes = plot.plot_diagnosis(rec, diag)
-    sec["figures"].append({"svg": _svg(np.ravel(axes)[0].figure), "caption": "spectrum, envelope spectrum with the "
-                                                                             "fault comb, kurtogram, severity"})
+    if rec is not None:
+        sec["figures"].append({"svg": _svg(plot.plot_diagnosis(rec, diag)),
+                               "caption": "spectrum, envelope spectrum with the fault comb, kurtogram, severity"})
     return sec
 
 
@@ -174,8 +206,8 @@ def comparison_section(cmp, name):
                                                                          "deviation [%]", "in std", "verdict"],
                        "rows": [[_fmt(r["fn_measured_hz"], 6), _fmt(r["fn_predicted_hz"], 6),
                                  _fmt(r["fn_dev_pct"], 3), _fmt(r["fn_dev_std"], 3), r["verdict"]] for r in cmp.rows]}]}
-    ax = plot.plot_comparison(cmp)
-    sec["figures"].append({"svg": _svg(ax.figure), "caption": "frequency deviation per mode and the tolerance"})
+    sec["figures"].append({"svg": _svg(plot.plot_comparison(cmp)),
+                           "caption": "frequency deviation per mode and the tolerance"})
     return sec
 
 
@@ -197,8 +229,8 @@ def fleet_section(store, name):
                                     _fmt(r.alarm_limit, 4), r.verdict, r.reason] for r in tr.itertuples()]})
     # the trended metrics (a baseline to draw against) that are not ok
     for r in tr[(tr["verdict"] != "ok") & tr["baseline_mean"].notna()].head(4).itertuples():
-        ax = plot.plot_trend(store, asset=r.asset, point=r.point, metric=r.metric, task=r.task)
-        sec["figures"].append({"svg": _svg(ax.figure), "caption": f"{r.asset}/{r.point}: {label(r.metric)}"})
+        fig = plot.plot_trend(store, asset=r.asset, point=r.point, metric=r.metric, task=r.task)
+        sec["figures"].append({"svg": _svg(fig), "caption": f"{r.asset}/{r.point}: {label(r.metric)}"})
     return sec
 
 

@@ -73,6 +73,20 @@ def _num(x):
 _PLAIN = (str, int, bool, type(None))
 
 
+# flags that describe how a fit was made, not a doubt about its answer: neither shown nor warned about
+INFORMATIONAL_FLAGS = frozenset({"noise_floor"})
+
+
+def shown_flags(flags, mode_flags=None) -> list:
+    """The flags a picture, a table and a report show for one result: the record's then each mode's,
+    once each, in order, without the informational ones (one list, so a plot and its table agree)."""
+    out = []
+    for f in [*flags, *(f for m in (mode_flags or ()) for f in m)]:
+        if f not in out and f not in INFORMATIONAL_FLAGS:
+            out.append(f)
+    return out
+
+
 def jsonable(obj):
     """obj with numpy scalars and arrays, tuples, NaN and inf turned into what ``json.dumps`` writes
     (lists, floats, None): the one conversion every ``to_dict`` and the CLI's ``--json`` use."""
