@@ -517,9 +517,13 @@ def test_a_time_column_or_a_hammer_pulse_is_not_analysed_by_default(tmp_path):
     x = np.exp(-0.02 * 2 * np.pi * 12 * t) * np.cos(2 * np.pi * 12 * t)
     p = tmp_path / "headerless.csv"
     np.savetxt(p, np.vstack([t, x]).T, delimiter=",")
-    with pytest.warns(vm.QualityWarning, match="'ch0' looks like a time column; analysing 'ch1'"):
-        est = vm.ringdown(vm.read(p, fs=1000.0))
+    rec = vm.read(p)   # a headerless first column rising in uniform steps is the file's time base
+    assert rec.names == ["ch1"] and rec.fs == pytest.approx(1000.0) and "time_column" in rec.meta
+    est = vm.ringdown(rec)
     assert est.extras["channel"] == "ch1" and est.fn[0] == pytest.approx(12.0024, rel=1e-4)  # the damped fd oracle
+    with pytest.warns(vm.QualityWarning, match="'ch0' looks like a time column; analysing 'ch1'"):
+        est = vm.ringdown(vm.Record(np.vstack([t, x]), 1000.0))     # a record built with its time as data
+    assert est.extras["channel"] == "ch1"
     hammer = np.zeros(5000)
     hammer[100:104] = [0.2, 1.0, 0.7, 0.1]
     rec = vm.Record(np.vstack([hammer, np.r_[np.zeros(100), x[:4900]]]), 1000.0)

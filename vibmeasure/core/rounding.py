@@ -11,7 +11,10 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["with_std", "plain", "band"]
+__all__ = ["with_std", "plain", "band", "MAX_DIGITS"]
+
+#: significant digits a value is never printed beyond: a std below the 11th digit is round-off, not data
+MAX_DIGITS = 11
 
 
 def _finite(v) -> bool:
@@ -85,6 +88,8 @@ def with_std(value, std, *, sig: int = 2, digits: int = 6) -> tuple[str, str]:
     ('123500', '5600')
     >>> with_std(2.5e-7, 3.1e-9)
     ('2.500e-07', '0.031e-07')
+    >>> with_std(20.003999600079972, 8.0e-14)         # noise-free data: MAX_DIGITS at most
+    ('20.003999600', '8.0e-14')
     """
     if not _finite(value):
         return "n/a", plain(std, sig) if _finite(std) else "n/a"
@@ -92,6 +97,9 @@ def with_std(value, std, *, sig: int = 2, digits: int = 6) -> tuple[str, str]:
         return plain(value, digits), "n/a"
     value, std = float(value), float(std)
     last = math.floor(math.log10(std)) - (int(sig) - 1)       # power of ten of the std's last digit
+    if value != 0 and math.floor(math.log10(abs(value))) - last + 1 > MAX_DIGITS:
+        # a std at the round-off level (noise-free data): more digits would be the arithmetic's, not the data's
+        return _no_negative_zero(f"{value:#.{MAX_DIGITS}g}".rstrip(".")), f"{std:.{int(sig) - 1}e}"
     big = max(abs(value), std)
     if big >= 1e7 or big < 1e-4:                               # one shared power of ten
         p = math.floor(math.log10(big))

@@ -12,7 +12,7 @@ from ..core.errors import ParameterError
 from ..core.record import Record
 from ..core._validate import select_names
 from ._common import (DEFAULT_MAX_SAMPLES, MAX_CHANNELS, atomic_path, check_size, fs_from_time, make_record,
-                      parse_number, require_fs)
+                      parse_number, require_fs, TIME_STEP_RTOL)
 
 _FS_KEYS = ("fs", "fs_hz", "sampling_rate", "sample_rate", "samplerate", "sampling_frequency")
 _NAME_UNIT = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]*)\s*[\])]\s*$")
@@ -135,6 +135,9 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
     split = [_split_name_unit(lab) for lab in labels]
     names, units = [nm for nm, _ in split], [un for _, un in split]
     tcol, t_unit = _time_column(names)
+    unnamed_time = tcol is None and not has_header and _is_time_base(values)
+    if unnamed_time:   # a headerless first column that increases in uniform steps is the time base
+        tcol = 0
     if tcol is not None and t_unit and not units[tcol]:
         units[tcol] = t_unit      # time_ms, t_us: the unit in the name
     fs, t0 = _timing(values, units, tcol, header_kv, fs, src)
@@ -148,6 +151,8 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
     file_units = [chan_meta.get(names[i], (None, units[i] or ""))[1] for i in pick]
     meta = {k: v for k, v in header_kv.items() if k not in _FS_KEYS and k not in ("t0_s", "n_samples", "channels_json")}
     meta["source"] = str(path)
+    if unnamed_time:
+        meta["time_column"] = "column 1 (no header; read as time in s: it increases in uniform steps)"
     rec = make_record(values[:, pick].T, fs, [names[i] for i in pick], quantity=quantity, unit=unit,
                       quantities=quantities, units=file_units, t0=t0, meta=meta, source=src)
     if any(locations.values()):
@@ -155,6 +160,16 @@ def read_csv(path, *, fs=None, channels=None, quantity=None, unit=None, max_samp
         rec = rec.replace(channels=tuple(Channel(c.name, c.quantity, c.unit, locations.get(c.name, ""))
                                          for c in rec.channels))
     return rec
+
+
+def _is_time_base(values) -> bool:
+    """A first column (of two or more) that rises in uniform steps (``fs_from_time``'s tolerance) is a
+    time base: no vibration signal increases monotonically at a constant rate for a whole record."""
+    if values.ndim != 2 or values.shape[1] < 2 or values.shape[0] < 16:
+        return False
+    d = np.diff(values[:, 0])
+    step = float(np.median(d))
+    return bool(step > 0 and np.all(d > 0) and np.max(np.abs(d - step)) <= TIME_STEP_RTOL * step)
 
 
 _TIME_NAME = re.compile(r"^(time|t|zeit|seconds|timestamp)(?:[_ ]?(s|sec|ms|us))?$", re.I)
