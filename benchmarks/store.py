@@ -9,7 +9,7 @@ each. Printed per engine at 1k, 10k, 100k, ... results: the mean time of 10 comm
 database is given (the tests start a throw-away cluster the same way). Targets: commit cost flat
 (last / first <= 3), the year's query under 0.2 s.
 
-    python benchmarks/store.py [N_RESULTS] [--postgres postgresql://user@127.0.0.1:PORT/db]
+    python benchmarks/store.py [N_RESULTS] [--postgres postgresql://user@127.0.0.1:PORT/db] [--only h5|sqlite|postgres]
 """
 
 import sys
@@ -69,6 +69,9 @@ def main(argv):
     engines = [("HDF5 (.h5)", d / "s.h5", min(n, 20_000), None), ("SQLite (.db, WAL)", d / "s.db", n, None)]
     if pg:
         engines.append(("PostgreSQL", pg, n, d / "raw"))
+    if "--only" in argv:   # one engine: h5, sqlite or postgres
+        want = argv[argv.index("--only") + 1].lower()
+        engines = [e for e in engines if want in e[0].lower().replace("hdf5", "h5")]
     print(f"{ASSETS} assets measured hourly, commits of {PER_COMMIT} measurements with one result each\n")
     print(f"{'engine':20s} {'results':>9s} {'ms/commit':>10s} {'year query':>11s} {'trend':>8s} {'rows':>6s}")
     for name, target, m, raw in engines:

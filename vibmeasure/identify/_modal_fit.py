@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._lm import levenberg_marquardt
 from ._poles import pole_to_modal
 from .limits import MAX_REL_ZETA_STD
 
@@ -158,16 +159,45 @@ def _full_jacobian(w, theta, coef, sw, lw=None):
     return J
 
 
+def _fisher_information(w, theta, coef, sw, lw=None):
+    """J^T J of ``_full_jacobian`` built block by block, without the (rows x parameters) Jacobian: each
+    output's linear coefficients touch only that output's rows, so their block is sw_o^2 A^T A of the
+    one shared basis A, the pole-pole block sums the outputs' pole columns, and the cross blocks are
+    each output's pole columns against A. Equal to J.T @ J to round-off."""
+    lam = _lam(theta)
+    m, n_out = lam.size, coef.shape[1]
+    lw2 = _line_weights(lw, w.size)
+    A = _real(_basis(w, lam)) * lw2
+    p_nl, p_lin = 2 * m, A.shape[1]
+    F = np.zeros((p_nl + p_lin * n_out,) * 2)
+    AtA = A.T @ A
+    iw = (1j * w)[:, None]
+    da = 1 / (iw - lam[None, :]) ** 2
+    db = 1 / (iw - np.conj(lam)[None, :]) ** 2
+    for o in range(n_out):
+        R = coef[0:p_nl:2, o] + 1j * coef[1:p_nl:2, o]
+        a, b = da * R[None, :], db * np.conj(R)[None, :]
+        d = np.empty((w.size, p_nl), complex)
+        d[:, 0::2] = -(a + b)           # d/d sigma (lambda = -sigma + i wd)
+        d[:, 1::2] = 1j * (a - b)       # d/d wd
+        Jn = _real(d) * (lw2 * sw[o])
+        lin = slice(p_nl + p_lin * o, p_nl + p_lin * (o + 1))
+        F[:p_nl, :p_nl] += Jn.T @ Jn
+        F[:p_nl, lin] = Jn.T @ A * sw[o]
+        F[lin, :p_nl] = F[:p_nl, lin].T
+        F[lin, lin] = AtA * sw[o] ** 2
+    return F
+
+
 def _polish(w, H, lam0, sw, lw=None):
     """Poles by variable projection (residues and residual terms solved linearly inside), with the
-    decay rate as exp(q) so it stays positive; Levenberg-Marquardt (MINPACK) on Kaufman's Jacobian.
+    decay rate as exp(q) so it stays positive; Levenberg-Marquardt (``_lm``) on Kaufman's Jacobian.
 
     One QR of the basis per pole set serves both the residual and the Jacobian (MINPACK asks for
     both at each accepted point), and the evaluations are capped at 15 per parameter: a well-posed
     fit from the stabilisation's start converges in far fewer; a pole that runs away (towards zero
     or huge damping, out of the band) is pruned by the caller instead of being chased."""
     from scipy.linalg import solve_triangular
-    from scipy.optimize import least_squares
     Hw = H * sw[:, None]
     lw2 = _line_weights(lw, w.size)
     Y = np.vstack([Hw.real.T, Hw.imag.T]) * lw2  # (2 nf, n_out)
@@ -202,34 +232,43 @@ def _polish(w, H, lam0, sw, lw=None):
     def fun(q):
         return at(q)["r"]
 
-    def jac(q):
+    def normal(q):
         c = at(q)
-        J = _kaufman(c["th"], w, c["Q"], c["coef"], lw2)
-        J[:, 0::2] *= c["th"][0::2]  # d/dq = sigma d/dsigma
-        return J
+        A, g = _kaufman_normal(c["th"], w, c["Q"], c["coef"], lw2, c["r"])
+        d = np.ones(q.size)
+        d[0::2] = c["th"][0::2]       # d/dq = sigma d/dsigma
+        return A * np.outer(d, d), g * d
     scale = np.column_stack([np.ones(lam0.size), np.maximum(sig0, w[1] - w[0])]).ravel()
-    sol = least_squares(fun, q0, jac=jac, x_scale=scale, xtol=1e-10, ftol=1e-10, gtol=1e-10, method="lm",
-                        max_nfev=15 * (q0.size + 1))
-    theta = theta_of(sol.x)
-    r, coef = _varpro(theta, w, Hw, lw)
-    return theta, coef, r
+    q, _ = levenberg_marquardt(fun, normal, q0, scale, max_nfev=15 * (q0.size + 1))
+    c = at(q)
+    return c["th"], c["coef"], c["r"]
 
 
-def _kaufman(theta, w, Q, coef, lw2):
-    """Kaufman's variable-projection Jacobian -P_perp (dA/dtheta) c for each output, stacked, given
-    the (line-weighted) basis' orthonormal Q and the linear coefficients at theta."""
+def _kaufman_normal(theta, w, Q, coef, lw2, r):
+    """The normal equations (J^T J, J^T r) of Kaufman's variable-projection Jacobian J = -P_perp
+    (dA/dtheta) c, over (sigma, wd) per mode, without forming J (rows x 2m for every output).
+
+    The derivative columns of a mode's two basis columns do not depend on the output: with D (2 nf x
+    4m: per mode and parameter, the derivatives of the u and v columns), G = D^T P_perp D = D^T D -
+    (Q^T D)^T (Q^T D) serves every output, J^T J = sum over outputs of C_o^T G C_o with each output's
+    residue coefficients C_o, and J^T r = -C^T D^T r since the residual already lies in P_perp's range."""
     lam = _lam(theta)
-    iw = 1j * w
-    cols = []
-    for r, l in enumerate(lam):
-        da = 1 / (iw - l) ** 2
-        db = 1 / (iw - np.conj(l)) ** 2
-        for d_a, d_b in ((-da, -db), (1j * da, -1j * db)):   # d/d sigma, d/d wd
-            dC1, dC2 = d_a + d_b, 1j * (d_a - d_b)
-            v = (_real(np.column_stack([dC1, dC2])) * lw2) @ coef[2 * r:2 * r + 2]  # (2 nf, n_out)
-            v = v - Q @ (Q.T @ v)
-            cols.append(-v.ravel(order="F"))
-    return np.column_stack(cols)
+    m, n_out, nf = lam.size, coef.shape[1], w.size
+    iw = (1j * w)[:, None]
+    da = 1 / (iw - lam[None, :]) ** 2
+    db = 1 / (iw - np.conj(lam)[None, :]) ** 2
+    s, d = da + db, da - db
+    Dc = np.empty((nf, m, 2, 2), complex)   # line, mode, parameter (sigma, wd), column (u, v)
+    Dc[:, :, 0, 0], Dc[:, :, 0, 1] = -s, -1j * d      # d/d sigma, lambda = -sigma + i wd
+    Dc[:, :, 1, 0], Dc[:, :, 1, 1] = 1j * d, -s       # d/d wd
+    D = np.concatenate([Dc.real.reshape(nf, -1), Dc.imag.reshape(nf, -1)]) * lw2
+    QtD = Q.T @ D
+    G = (D.T @ D - QtD.T @ QtD).reshape(m, 2, 2, m, 2, 2)
+    C = coef[:2 * m].reshape(m, 2, n_out)
+    A = np.einsum("rko,rpksql,slo->rpsq", C, G, C).reshape(2 * m, 2 * m)
+    DtR = (D.T @ r.reshape(n_out, 2 * nf).T).reshape(m, 2, 2, n_out)
+    g = -np.einsum("rko,rpko->rp", C, DtR).reshape(2 * m)
+    return A, g
 
 
 LOCAL_LINES = 20     # a mode's neighbourhood: +-this many lines, or
@@ -243,10 +282,9 @@ def _covariance(w, theta, coef, r, sw, lw=None):
     A mode's parameters are scaled by the residual variance near it (``_local_variance``), not the
     band's: its information comes from the lines around it, and misfit or noise far away (another
     mode's nonlinearity, a band edge) must not move its std, nor its acceptance, with the band."""
-    J = _full_jacobian(w, theta, coef / sw[None, :], sw, lw)
-    dof = max(r.size - J.shape[1], 1)
+    JtJ = _fisher_information(w, theta, coef / sw[None, :], sw, lw)
+    dof = max(r.size - JtJ.shape[0], 1)
     s2 = float(r @ r) / dof
-    JtJ = J.T @ J
     try:
         cov = np.linalg.inv(JtJ)
     except np.linalg.LinAlgError:
