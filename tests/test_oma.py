@@ -237,6 +237,14 @@ def test_cli_oma(tmp_path):
     doc = json.loads(out.getvalue())
     assert doc["method"] == "oma_ssi" and len(doc["extras"]["cross_check"]) == len(doc["modes"]) == 5
     assert all(c["other_fn_hz"] is not None and c["zeta_sigma"] < 3 for c in doc["extras"]["cross_check"])
+    # a CSV of bare columns carries no unit: --unit gives it (issue 49: every option a real file needs)
+    rec = vm.read(path)
+    np.savetxt(tmp_path / "bare.csv", np.column_stack([rec.time, rec.data.T]), delimiter=",",
+               header=",".join(["time"] + [f"s{i}" for i in range(rec.n_channels)]), comments="")
+    out = io.StringIO()
+    assert main(["oma", str(tmp_path / "bare.csv"), "--band", "1", "80", "--unit", "g", "--json"], out=out,
+                err=io.StringIO()) == 0
+    assert json.loads(out.getvalue())["unit"] == "g"
 
 
 def test_the_duration_rule_is_on_the_modes_and_fdd_has_ssis_defaults():

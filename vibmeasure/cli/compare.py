@@ -19,6 +19,7 @@ def register(sub) -> None:
     ref.add_argument("--model", help="model.toml")
     ref.add_argument("--baseline", help="baseline history (.h5 written by vm.History.save)")
     cp.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
+    cp.add_argument("--unit", help="unit of the data when the file does not say (e.g. g)")
     cp.add_argument("--channel", help="response channel for a ring-down")
     cp.add_argument("--input", help="force channel: identify from FRFs with fit_modes instead of a ring-down")
     cp.add_argument("--band", nargs=2, type=float, metavar=("LO", "HI"), help="band for fit_modes / ringdown")
@@ -42,13 +43,14 @@ def run(args, out, err) -> int:
         if args.input:
             args.variable, args.impact, args.output = None, False, None
             args.estimator, args.window, args.nperseg = "H1", "hann", None
+            args.quantity, args.unit = None, [args.unit] if args.unit else None   # frf's [CHANNEL=]UNIT form
             frf = get_frf(args)
             from ..identify.modal import fit_modes
             if band is None:
                 raise VibMeasureError("--band LO HI is required with --input (the fit_modes band)")
             est = fit_modes(frf, band=band)
         else:
-            rec = io.read(args.file, fs=args.fs)
+            rec = io.read(args.file, fs=args.fs, unit=args.unit)
             est = rd.ringdown(rec, channel=args.channel, band=band)
         cmp = compare(est, pred, rtol_fn=args.rtol_fn)
         if args.plot:

@@ -20,6 +20,7 @@ def register(sub) -> None:
                     help="frequency band (Hz); default the whole range")
     om.add_argument("--channel", action="append", help="output channel(s) (default: all that are not forces)")
     om.add_argument("--fs", type=float, help="sampling rate in Hz (required when the file has no timing)")
+    om.add_argument("--unit", help="unit of the data when the file does not say (e.g. g)")
     om.add_argument("--max-order", type=int, default=40, help="ssi: highest model order (default 40)")
     om.add_argument("--block-rows", type=int, help="ssi: block rows (covariance lags; default max(30, order))")
     om.add_argument("--nperseg", type=int, help="fdd: segment length of the cross-spectra")
@@ -33,7 +34,7 @@ def run(args, out, err) -> int:
     stabilisation diagram or singular values as a picture."""
     from .. import io
     from ..identify.oma import oma_cross_check, oma_fdd, oma_ssi
-    rec = io.read(args.file, fs=args.fs, channels=args.channel)
+    rec = io.read(args.file, fs=args.fs, unit=args.unit, channels=args.channel)
     band = tuple(args.band) if args.band else None
     with quality_warnings() as msgs:
         if args.method in ("ssi", "both"):
