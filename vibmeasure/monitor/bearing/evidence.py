@@ -166,6 +166,9 @@ def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
         own = [s for s in votes.get(name, ()) if not s.given]
         fams[name]["views"] = max(_views(own), 1 if len(own) < len(votes.get(name, ())) else 0)
         fams[name]["band_given_only"] = bool(votes.get(name)) and not own
+        # the family's strength in the record's own spectra: what may stand in the way of another finding
+        own_p = [s.results[name]["logp"] for s in (own or [s for s in pool if not s.given]) if name in s.results]
+        fams[name]["log_p_own"] = min(0.0, min(own_p, default=0.0) + np.log(n_sp))   # corrected as _summary's
         if name in FAMILIES and not votes[name]:
             fams[name]["found"] = False   # only ever significant on lines another family explains better
         elif name in FAMILIES and _one_view(fams[name], fams[name]["views"], n_views):
@@ -175,9 +178,10 @@ def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
 
 def _smeared_if_none(fams, spectra, freqs, f1):
     """No family's lines pass and no race's are significant: is the ball's comb there, smeared?"""
-    # a comb that only a user's band shows (``band_given_only``) does not stand in the way
+    # a comb that only a user's band shows (``band_given_only``, or significant in none of the record's
+    # own spectra: ``log_p_own``) does not stand in the way
     if any(fams[n]["found"] and not fams[n].get("band_given_only") for n in FAMILIES) or any(
-            fams[n]["log_p"] < np.log(ALPHA) and not fams[n].get("band_given_only")
+            fams[n].get("log_p_own", fams[n]["log_p"]) < np.log(ALPHA) and not fams[n].get("band_given_only")
             for n in FAMILIES if n != "bearing_ball"):
         return None
     smeared = _smeared_ball(spectra, freqs, f1)

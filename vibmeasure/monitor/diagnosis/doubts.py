@@ -94,14 +94,18 @@ def band_given(ev, job, top: str, conf: float, reason: str) -> tuple[float, str]
     bearing candidate too (the flag, no hold: it names nothing)."""
     if ev is None or job.band is None:
         return conf, reason
-    if top == "undetermined":   # the strongest bearing candidate, when only the band given shows it
+    if top == "undetermined":   # a candidate that only the band given shows, when it stands in the way
         fams = [n for n in ev.families if n != "bearing_cage" and ev.families[n]["log_p"] < np.log(ALPHA)]
-        name = min(fams, key=lambda n: ev.families[n]["log_p"], default=None)
-        if name is None or not ev.families[name].get("band_given_only"):
+        only = [n for n in fams if ev.families[n].get("band_given_only")]
+        name = min(only, key=lambda n: ev.families[n]["log_p"], default=None)
+        if name is None:
             return conf, reason
-        return _held(job.flags, "band_unconfirmed", f"the strongest bearing candidate, {name}, only the band given "
-                     f"({job.band[0]:g}-{job.band[1]:g} Hz) shows: check that band holds the bearing's resonance",
-                     conf, reason, hold=False)
+        others = [n for n in fams if n not in only]
+        against = (f", against {', '.join(others)}, which the record's own bands show (analyse without band= to "
+                   "see it named)") if others else ""
+        return _held(job.flags, "band_unconfirmed", f"bearing candidate {name} only the band given "
+                     f"({job.band[0]:g}-{job.band[1]:g} Hz) shows{against}: check that band holds the bearing's "
+                     "resonance", conf, reason, hold=False)
     if top not in ev.families or not ev.families[top].get("band_given_only"):
         return conf, reason
     return _held(job.flags, "band_unconfirmed", f"only the band given ({job.band[0]:g}-{job.band[1]:g} Hz) shows "

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy import fft as _sfft
 
 from .iso import ISO_10816_3, ISO_SCOPE_RPM, severity_zone
 
@@ -36,7 +37,7 @@ def _severity(job: Job, f, rpm, electrical_hz=(), electrical_amp=()):
     # leakage over the record's ends (1/f, divided again by 2 pi f for velocity)
     # fills the band: 0.3 g/s read zone C on a zone-A machine. (No window: the gated transients' share
     # ``kept`` restores the power of a rectangular record.)
-    spec = np.fft.rfft(_without_drift(job.a))
+    spec = _sfft.rfft(_without_drift(job.a))
     v_rms = float(np.sqrt(np.sum(np.abs(spec[sel] / (2 * np.pi * f[sel])) ** 2) * 2 / kept) / n) * 1e3 \
         if sel.any() else np.nan
     hz, amp = np.asarray(electrical_hz, float), np.asarray(electrical_amp, float)

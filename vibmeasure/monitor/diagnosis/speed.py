@@ -24,6 +24,11 @@ from .tracking import DRIFT_P, SPEED_DRIFT, _order_tracked_job, _speed_drift, _s
 # 1X lies 13.8 % away); the strongest line within +-6 % alone finds all 57 only from 0.97 to 1.03 x.
 SPEED_SEARCH = 0.12
 SPEED_NOTED = 0.01   # a 1X this far from the declared speed is said so in the answer
+# a 0.5X line (with 1.5X standing too) this many dB or more over the 1X makes the 1X a 2X: the 53 development
+# records at their true fs read 0.5X at 10 dB or more under the 1X, at half their fs up to 25.6 dB over it
+# (the true 1X over the true 2X; 21 of them 6 dB or more); a loose machine's sub-harmonic reads -2.9 to
+# +0.4 dB (synth.machine): below this, the two cannot be told apart by the lines
+HALF_OVER_1X_DB = 6.0
 # A 1X candidate more than SPEED_NOTED from the declared speed confirms the speed it shows only with at
 # least ONE_X_CONFIRMS of its harmonics 2X-6X; with fewer, neither it nor the declared speed is confirmed
 # and the bearing's own lines are searched at other speeds, as when no 1X is found. Reason: MFPT's
@@ -54,10 +59,13 @@ def _speed(job: Job, f, A):
             job.flags.append("speed_corrected")
     for r in (4, 2):
         # a mains line is no sub-harmonic (a 60 Hz line stood for 7/4 X of a 2100 rpm looseness machine)
-        hits = [db >= LINE_DB and not _at_mains(fk, df, job.mains)
-                for fk, _, db in (_line(f, A, k * f1 / r, max(2 * df, 0.01 * k * f1 / r), 0.5 * f1 / r)
-                                  for k in range(1, 2 * r) if k % r)]
-        if r == 4 and sum(hits) >= 3 or r == 2 and all(hits) and snr1 < LINE_DB:
+        lines = [_line(f, A, k * f1 / r, max(2 * df, 0.01 * k * f1 / r), 0.5 * f1 / r) for k in range(1, 2 * r)
+                 if k % r]
+        hits = [db >= LINE_DB and not _at_mains(fk, df, job.mains) for fk, _, db in lines]
+        # at half the true fs the true 1X reads 0.5X and the true 2X stands where the 1X is looked for:
+        # a 0.5X line about as high as the "1X" says so (HALF_OVER_1X_DB)
+        if r == 4 and sum(hits) >= 3 or r == 2 and all(hits) and (snr1 < LINE_DB or
+                                                                    lines[0][2] >= snr1 + HALF_OVER_1X_DB):
             speed.update(consistent=False, fs_ratio=r, note=(
                 f"lines at {1 / r:g}X, ... fit a shaft speed of {job.rpm:g} rpm only if fs is {r}x the declared "
                 f"{job.fs:g} Hz ({r * job.fs:g} Hz): check the sampling rate"))
