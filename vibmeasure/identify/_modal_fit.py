@@ -367,6 +367,28 @@ def _unsupported(theta, coef, cov, sw, tau, n_lines, n_out, band, df):
     return out
 
 
+def _astray_poles(theta, cov, astray, tau, band, refused) -> list:
+    """The in-band poles (not yet refused) whose own neighbourhood does not hold them (``_local_refit``:
+    fitted alone on the lines around them, the other modes subtracted, they leave their peak), as
+    (index, reason dict). A mode is a peak of its own; a pole the band fit keeps only as a share of the
+    baseline (a misfit spread over the band, a runaway pole's company) is not one."""
+    out = []
+    for k in astray:
+        if k in refused:
+            continue
+        sig = theta[2 * k] - (1.0 / tau if tau else 0.0)
+        wd = theta[2 * k + 1]
+        wn = np.hypot(sig, wd)
+        fn, zeta = wn / (2 * np.pi), sig / wn
+        if not (band[0] <= fn <= band[1]) or not 0 < zeta < 0.5:
+            continue   # left to the physical screen
+        zeta_std = pole_to_modal(sig, wd, cov[2 * k:2 * k + 2, 2 * k:2 * k + 2])[3]
+        out.append((k, {"fn_hz": float(fn), "zeta": float(zeta), "zeta_std": float(zeta_std), "wald": float("nan"),
+                        "reason": "not held by its own neighbourhood: fitted alone on the lines around it (the "
+                                  "other modes subtracted), the pole leaves its peak"}))
+    return out
+
+
 def _residual_search(w, H, theta, coef, r, sw, n_modes, max_add=4, lw=None):
     """Add modes that the stabilisation missed (weak ones, near the noise): where the weighted
     residual, summed over outputs and a few lines, stands out of its chi-square level, start a pole
@@ -429,10 +451,12 @@ def _local_refit(w, H, theta, coef, cov, sw):
     so a wide band bends a weak mode's baseline and its zeta and std moved with the band's reach
     (case1's 34 Hz mode: zeta 2.1e-4 +- 2e-5 in 20-50 Hz, refused in 10-600 Hz); the local fit is the
     same whatever the band holds beyond the neighbourhood. A local fit that fails or runs out of
-    the neighbourhood leaves the band fit's values."""
+    the neighbourhood leaves the band fit's values; the modes whose local pole left their own peak
+    are returned too (``astray``: the screen asks whether the data supports them)."""
     m, n_out = theta.size // 2, H.shape[0]
+    astray: list = []
     if m == 0:
-        return theta, coef, cov
+        return theta, coef, cov, astray
     theta, coef, cov = theta.copy(), coef.copy(), cov.copy()
     dw = float(np.median(np.diff(w)))
     B = _basis(w, _lam(theta))
@@ -453,7 +477,8 @@ def _local_refit(w, H, theta, coef, cov, sw):
         except (np.linalg.LinAlgError, ValueError):
             continue
         if not (abs(th[1] - wd) < max(2 * sig, 2 * dw) and 0 < th[0] < 3 * sig + dw):
-            continue   # the local fit moved the pole out of the mode's own peak: the band fit stands
+            astray.append(k)   # the local fit moved the pole out of the mode's own peak: the band fit stands
+            continue
         idx = [2 * k, 2 * k + 1] + [2 * m + p_lin * o + 2 * k + j for o in range(n_out) for j in (0, 1)]
         loc = [0, 1] + [2 + 8 * o + j for o in range(n_out) for j in (0, 1)]
         theta[2 * k:2 * k + 2] = th
@@ -461,4 +486,4 @@ def _local_refit(w, H, theta, coef, cov, sw):
         cov[idx, :] = 0.0
         cov[:, idx] = 0.0
         cov[np.ix_(idx, idx)] = ck[np.ix_(loc, loc)]
-    return theta, coef, cov
+    return theta, coef, cov, astray

@@ -17,7 +17,7 @@ from ..core._threads import single_threaded
 from ..core._validate import check_band, name_index
 from ..core.errors import FitError, ParameterError, warn_quality
 from ..core.results import FRF, ModalEstimate
-from ._modal_fit import (FALSE_ALARM, LOCAL_LINES, MAX_REL_ZETA_STD, _covariance, _full_jacobian,  # noqa: F401 (tests, modal_crb)
+from ._modal_fit import (FALSE_ALARM, _astray_poles, LOCAL_LINES, MAX_REL_ZETA_STD, _covariance, _full_jacobian,  # noqa: F401 (tests, modal_crb)
                          _lam, _local_refit, _lscf_poles, _polish, _residual_search, _residual_terms, _stabilise, _unsupported,
                          synthesize_frf_from)
 from ._poles import pole_to_modal
@@ -214,8 +214,9 @@ def _screen(w, H, theta, coef, r, sw, lw, tau, band, n_modes):
     rejected: list[dict] = []
     for _round in range(theta.size // 2 + 1):
         cov, s2 = _covariance(w, theta, coef, r, sw, lw)
-        theta, coef, cov = _local_refit(w, H, theta, coef, cov, sw)
+        theta, coef, cov, astray = _local_refit(w, H, theta, coef, cov, sw)
         out = _unsupported(theta, coef, cov, sw, tau, f.size, H.shape[0], band, float(np.median(np.diff(f))))
+        out += _astray_poles(theta, cov, astray, tau, band, {k for k, _ in out})
         if not out or n_modes is not None:
             break
         rejected += [d for _, d in out]
