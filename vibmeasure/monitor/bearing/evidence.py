@@ -167,7 +167,8 @@ def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
         fams[name]["views"] = max(_views(own), 1 if len(own) < len(votes.get(name, ())) else 0)
         fams[name]["band_given_only"] = bool(votes.get(name)) and not own
         # the family's strength in the record's own spectra: what may stand in the way of another finding
-        own_p = [s.results[name]["logp"] for s in (own or [s for s in pool if not s.given]) if name in s.results]
+        own_p = [s.results[name]["logp"] for s in (own or [s for s in pool if not s.given])
+                 if s.results.get(name) is not None]
         fams[name]["log_p_own"] = min(0.0, min(own_p, default=0.0) + np.log(n_sp))   # corrected as _summary's
         if name in FAMILIES and not votes[name]:
             fams[name]["found"] = False   # only ever significant on lines another family explains better
