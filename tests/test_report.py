@@ -246,5 +246,6 @@ def test_a_backbone_model_that_does_not_fit_prints_no_parameter():
     ok = {"fits": True, "fn0_hz": 10.0, "fn0_std_hz": 0.0012, "k3_over_k": 0.05, "k3_over_k_std": 0.0031,
           "zeta_viscous": 0.0104, "zeta_viscous_std": 0.00021, "friction_term": 1e-5, "friction_term_std": 2e-5,
           "quadratic_term": 0.0, "quadratic_term_std": 1e-3}
-    rows = _backbone_model_table(ok)["rows"]
+    rows = _backbone_model_table(ok, "mm")["rows"]
     assert rows[0][1:] == ["10.0000", "0.0012"] and rows[2][1:] == ["0.01040", "0.00021"]
+    assert rows[1][0] == "cubic stiffness k3/k [1/mm^2]" and rows[3][0] == "friction term [mm]"

@@ -115,20 +115,20 @@ def ringdown_section(rec, est, name):
                               "header": ["amplitude", "fn [Hz]", "± std", "zeta", "± std"],
                               "rows": [[_fmt(r.amplitude, 4), *_pm(r.fn_hz, r.fn_std_hz), *_pm(r.zeta, r.zeta_std)]
                                        for r in b.itertuples()]})
-        sec["tables"].append(_backbone_model_table(est.extras.get("backbone_model", {}).get(k)))
+        sec["tables"].append(_backbone_model_table(est.extras.get("backbone_model", {}).get(k), est.unit))
         sec["figures"].append({"svg": _svg(plot.plot_backbone(est, mode=k)),
                                "caption": "damping and frequency versus amplitude"})
     return sec
 
 
 _MODEL_ROWS = (("natural frequency at zero amplitude fn0 [Hz]", "fn0_hz", "fn0_std_hz"),
-               ("cubic stiffness k3/k [1/unit^2]", "k3_over_k", "k3_over_k_std"),
+               ("cubic stiffness k3/k [1/{u}^2]", "k3_over_k", "k3_over_k_std"),
                ("viscous damping ratio zeta_v [-]", "zeta_viscous", "zeta_viscous_std"),
-               ("friction term [unit]", "friction_term", "friction_term_std"),
-               ("quadratic damping term [1/unit]", "quadratic_term", "quadratic_term_std"))
+               ("friction term [{u}]", "friction_term", "friction_term_std"),
+               ("quadratic damping term [1/{u}]", "quadratic_term", "quadratic_term_std"))
 
 
-def _backbone_model_table(model) -> dict:
+def _backbone_model_table(model, unit: str = "") -> dict:
     """The weakly nonlinear model fitted to the backbone, or, when it fails its goodness-of-fit test,
     a table that says so and why: the windows then stand alone and no model number is printed."""
     head = ["parameter", "value", "± std"]
@@ -139,7 +139,8 @@ def _backbone_model_table(model) -> dict:
                            f"describes these windows: {model.get('reason') or 'lack of fit'}. Quote the windows "
                            "above with their amplitudes, not a model parameter.", "header": head, "rows": []}
     return {"caption": "Weakly nonlinear model of the backbone (fits the windows within their std)", "header": head,
-            "rows": [[what, *_pm(model[key], model[std])] for what, key, std in _MODEL_ROWS]}
+            "rows": [[what.format(u=unit or "amplitude unit"), *_pm(model[key], model[std])]
+                     for what, key, std in _MODEL_ROWS]}
 
 
 def modes_section(frf, est, name):
