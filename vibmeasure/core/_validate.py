@@ -62,9 +62,15 @@ def available_memory() -> float:
     return avail
 
 
+SMALL_WORK = 16 * 2 ** 20   # bytes
+
+
 def check_memory(nbytes: float, what: str, n_samples: int) -> None:
     """Refuse, before allocating, work that needs more memory than the process can get, with the
-    size needed and what to do."""
+    size needed and what to do. Below SMALL_WORK bytes the system is not asked: reading it costs more
+    than such work, and an allocation that small failing is a MemoryError memory_guard names."""
+    if nbytes < SMALL_WORK:
+        return
     avail = available_memory()
     if nbytes > 0.9 * avail:
         raise ParameterError(f"{what}: {n_samples:,} samples need about {nbytes / 2**30:.1f} GiB of working memory, "

@@ -17,14 +17,17 @@ CLIP_RUN = 3  # consecutive samples at the extreme that count as clipping
 def clipped_mask(x: np.ndarray) -> np.ndarray:
     """True where a run of CLIP_RUN or more consecutive samples sits at the record's max or min."""
     mask = np.zeros(x.size, bool)
-    tol = 1e-12 * max(np.ptp(x), np.finfo(float).tiny)
-    med = np.median(x)
-    reach = np.max(np.abs(x - med))
-    for ext in (x.max(), x.min()):
-        if abs(ext - med) < 0.5 * reach:  # a plateau near the resting value is not clipping
-            continue
+    hi, lo = x.max(), x.min()
+    tol = 1e-12 * max(hi - lo, np.finfo(float).tiny)
+    med = None
+    for ext in (hi, lo):
         at = np.abs(x - ext) <= tol
         if at.sum() < CLIP_RUN:
+            continue
+        if med is None:
+            med = np.median(x)
+            reach = max(hi - med, med - lo)
+        if abs(ext - med) < 0.5 * reach:  # a plateau near the resting value is not clipping
             continue
         d = np.diff(np.concatenate(([0], at.view(np.int8), [0])))
         starts, ends = np.flatnonzero(d == 1), np.flatnonzero(d == -1)

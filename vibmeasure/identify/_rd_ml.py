@@ -51,21 +51,25 @@ def _evaluate(p, x, w, t, tn, nm, want_model=False):
         rss += float(r @ r)
         if want_model:
             model_all[s0:s1] = model
-    JtJ = np.triu(JtJ) + np.triu(JtJ, 1).T
+    JtJ = JtJ + JtJ.T   # dsyrk filled the upper triangle (the lower is zero): mirror it
+    JtJ.flat[::P + 1] *= 0.5
     return rss, JtJ, Jtr, model_all
 
 
-def _lm(p, x, w, t, tn, nm, max_iter=80):
+def _lm(p, x, w, t, tn, nm, max_iter=80, want_model=False):
+    """(p, rss, Fisher matrix, and with ``want_model`` the model at p, kept from the evaluation
+    that accepted it rather than computed again)."""
     with np.errstate(over="ignore", invalid="ignore"):
-        return _lm_inner(p, x, w, t, tn, nm, max_iter)
+        out = _lm_inner(p, x, w, t, tn, nm, max_iter, want_model)
+    return out if want_model else out[:3]
 
 
-def _lm_inner(p, x, w, t, tn, nm, max_iter):
+def _lm_inner(p, x, w, t, tn, nm, max_iter, want_model):
     """Levenberg-Marquardt with Nielsen's damping update (the damping follows the ratio of the
     actual to the predicted gain, so it neither bounces nor stalls in the long valleys that a
     slow baseline component makes with the offset and drift terms)."""
     sig_min = -1.0 / max(t[-1], 1e-300)  # a mode may grow at most e-fold over the record
-    rss, A, g, _ = _evaluate(p, x, w, t, tn, nm)
+    rss, A, g, model = _evaluate(p, x, w, t, tn, nm, want_model)
     lam, nu = 1e-4, 2.0
     slow = 0
     for _ in range(max_iter):
@@ -82,7 +86,7 @@ def _lm_inner(p, x, w, t, tn, nm, max_iter):
         if nm:
             pn[1:4 * nm:4] = np.abs(pn[1:4 * nm:4])
             pn[0:4 * nm:4] = np.maximum(pn[0:4 * nm:4], sig_min)
-        rss_n, An_, gn, _ = _evaluate(pn, x, w, t, tn, nm)
+        rss_n, An_, gn, model_n = _evaluate(pn, x, w, t, tn, nm, want_model)
         # predicted gain of the damped Gauss-Newton step (scaled variables): h'(lam h + g)
         pred = float(hn @ (lam * hn + g / d))
         if np.isfinite(rss_n) and np.all(np.isfinite(gn)) and rss_n <= rss:
@@ -94,7 +98,7 @@ def _lm_inner(p, x, w, t, tn, nm, max_iter):
                 small &= abs(step[4 * k + 2]) < 1e-11 * amp and abs(step[4 * k + 3]) < 1e-11 * amp
             gain = rss - rss_n
             rho = gain / pred if pred > 0 else 0.0
-            p, rss, A, g = pn, rss_n, An_, gn
+            p, rss, A, g, model = pn, rss_n, An_, gn, model_n
             lam = max(lam * max(1 / 3, 1 - (2 * rho - 1) ** 3), 1e-15)
             nu = 2.0
             if small or gain <= 1e-15 * rss:
@@ -112,7 +116,7 @@ def _lm_inner(p, x, w, t, tn, nm, max_iter):
             nu *= 2
             if lam > 1e12:
                 break
-    return p, rss, A
+    return p, rss, A, model
 
 
 def _converged(p, A, g, step, s2, nm, t_end) -> bool:
@@ -121,12 +125,13 @@ def _converged(p, A, g, step, s2, nm, t_end) -> bool:
     millionth of one noise variance. (Baseline wander, under two cycles in the span, is a nuisance:
     its slow crawl along the valley it forms with the drift term does not move the modes.)"""
     try:
-        Ainv_d = np.diag(np.linalg.inv(A))
-        dec = float(g @ np.linalg.solve(A, g))
+        Ainv = np.linalg.inv(A)
+        Ainv_d = np.diag(Ainv)
+        dec = float(g @ Ainv @ g)
     except np.linalg.LinAlgError:
         Ainv_d, dec = np.full(p.size, np.inf), np.inf
     osc = [k for k in range(nm) if abs(p[4 * k + 1]) * t_end >= 4 * np.pi]
-    nl_idx = np.r_[[4 * k for k in osc], [4 * k + 1 for k in osc]].astype(int)
+    nl_idx = np.array([4 * k for k in osc] + [4 * k + 1 for k in osc], dtype=int)
     if osc and np.all(np.abs(step[nl_idx]) < 1e-3 * np.sqrt(np.maximum(s2 * Ainv_d[nl_idx], 0))):
         return True
     return dec < 1e-6 * s2

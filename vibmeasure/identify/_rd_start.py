@@ -121,13 +121,19 @@ def _linear_amplitudes(x, w, t, sig, om, tn):
     C, S = _basis(t, sig, om)
     A = np.column_stack([C, S, np.ones_like(t), tn])
     Aw = A * w[:, None]
-    coef, *_ = np.linalg.lstsq(Aw, x * w, rcond=None)
+    # one SVD gives both the least-squares amplitudes (singular values below eps max(M, N) of the
+    # largest dropped, as lstsq) and the pseudo-inverse of the normal matrix (its eigenvalues
+    # sv^2 below 1e-15 of the largest dropped, as pinv)
+    U, sv, Vt = np.linalg.svd(Aw, full_matrices=False)
+    keep = sv > np.finfo(float).eps * max(Aw.shape) * sv[0]
+    coef = Vt[keep].T @ ((U[:, keep].T @ (x * w)) / sv[keep])
     res = (x - A @ coef) * w
     k = sig.size
     # each mode's share of the fit: the rise in the residual sum of squares if it were left out
     # (Wald form b' inv(cov_bb) b), in full-record units; unlike its energy this stays small for
     # collinear look-alikes (sidelobes) that cancel each other
-    G = np.linalg.pinv(Aw.T @ Aw)
+    kg = sv ** 2 > 1e-15 * sv[0] ** 2
+    G = (Vt[kg].T / sv[kg] ** 2) @ Vt[kg]
     drss = np.empty(k)
     for i in range(k):
         idx = [i, k + i]

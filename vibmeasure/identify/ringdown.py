@@ -333,9 +333,11 @@ def _trim_to_noise_floor(d: _Decay, s: _Start) -> None:
         n_end = int(min(d.x.size, max(np.ceil(t_floor * d.fsr) + 1, 64)))
         # the extrapolation never cuts a component the data shows alive (a decay whose damping falls
         # with its amplitude outlives its start's rate): the longest-lived one is followed in blocks
-        k = int(np.argmax(np.where(np.isfinite(floor), 1.0 / s.sig, -np.inf)))
-        broad = noise_std(d.x, d.fsr)
-        n_end = max(n_end, min(d.x.size, alive_until(d.x, d.fsr, s.om[k] / (2 * np.pi), s.sig[k], broad)))
+        # (only a cut needs the check: the block search can lengthen the span, never past the record)
+        if n_end < d.x.size:
+            k = int(np.argmax(np.where(np.isfinite(floor), 1.0 / s.sig, -np.inf)))
+            broad = noise_std(d.x, d.fsr)
+            n_end = max(n_end, min(d.x.size, alive_until(d.x, d.fsr, s.om[k] / (2 * np.pi), s.sig[k], broad)))
         if n_end < d.x.size and "noise_floor" not in d.flags:
             d.flags.append("noise_floor")
     d.x, d.w = d.x[:n_end], d.w[:n_end]
@@ -374,7 +376,7 @@ def _fit_full(d: _Decay, p, q):
         nm = (p.size - 2) // 4
         if q > 1:  # converge on every q-th sample first: the full record then needs a step or two
             p, _, _ = _lm(p, x[::q], w[::q], t[::q], tn[::q], nm)
-        p, rss, A = _lm(p, x, w, t, tn, nm)
+        p, rss, A, model = _lm(p, x, w, t, tn, nm, want_model=True)
         d.tick(0.3 + 0.6 * (_round + 1) / (d.max_modes + 2))
         dof = max(w.sum() - p.size, 1.0)
         s2 = max(rss / dof, (NUM_FLOOR * float(np.max(np.abs(x)))) ** 2 * 1e-6)
@@ -382,7 +384,7 @@ def _fit_full(d: _Decay, p, q):
         if not (share <= DETECT * s2).any() or nm == 1:
             break
         p = _drop_weakest(p, share)
-    return p, A, s2
+    return p, A, s2, model
 
 
 @dataclass
@@ -411,7 +413,7 @@ def _ml_fit(d: _Decay, s: _Start) -> _Fit:
     q = d.x.size // SUBSAMPLE
     if q > 1:
         p = _screen_subsampled(d, p, q)
-    p, A, s2 = _fit_full(d, p, q)
+    p, A, s2, model = _fit_full(d, p, q)
     nm = (p.size - 2) // 4
     try:
         cov = s2 * np.linalg.inv(A)
@@ -419,7 +421,6 @@ def _ml_fit(d: _Decay, s: _Start) -> _Fit:
         cov = s2 * np.linalg.pinv(A)
     sig, om = p[0:4 * nm:4], p[1:4 * nm:4]
     noise = float(np.sqrt(s2))
-    _, _, _, model = _evaluate(p, d.x, d.w, d.t, d.tn, nm, want_model=True)
     wn = np.hypot(om, sig)
     stds = np.array([pole_to_modal(sig[k], om[k], cov[4 * k:4 * k + 2, 4 * k:4 * k + 2])[2:] for k in range(nm)])
     scale = _colored_noise_scale((d.x - model) * d.w, d.w, d.fsr, om / (2 * np.pi), sig / np.pi, noise)

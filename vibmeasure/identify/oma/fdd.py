@@ -23,6 +23,9 @@ __all__ = ["oma_fdd"]
 
 
 # --- FDD / EFDD ---------------------------------------------------------------------------------
+SEG_BATCH = 16   # segments transformed in one call by _csd_matrix
+
+
 def _csd_matrix(Y, fs, nperseg):
     """Output cross-spectral matrix G (n_freq, l, l), Hann-windowed segments with 50 % overlap, each
     zero-padded to 2 nperseg so that the inverse transform of a bell is a linear (not circular)
@@ -38,14 +41,29 @@ def _csd_matrix(Y, fs, nperseg):
     n_g = min(N_GROUPS, n_seg // 2)
     n_g = n_g if n_g >= 3 and nf * l * l * 16 * n_g < 5e8 else 0
     Gg = np.zeros((max(n_g, 1), nf, l, l), complex)
-    for j, k0 in enumerate(starts):
-        X = np.fft.rfft(Y[:, k0:k0 + nperseg] * w, n=2 * nperseg, axis=1)  # (l, nf)
-        Gg[j * n_g // n_seg if n_g else 0] += np.einsum("if,jf->fij", X, X.conj())
+    group = np.array([j * n_g // n_seg if n_g else 0 for j in range(n_seg)])
+    # the segments of a group transformed together (at most SEG_BATCH at a time: memory stays bounded)
+    for g in range(Gg.shape[0]):
+        idx = np.flatnonzero(group == g)
+        for c0 in range(0, idx.size, SEG_BATCH):
+            ks = [starts[j] for j in idx[c0:c0 + SEG_BATCH]]
+            seg = np.stack([Y[:, k0:k0 + nperseg] for k0 in ks]) * w       # (segments, l, nperseg)
+            X = np.fft.rfft(seg, n=2 * nperseg, axis=2)                     # (segments, l, nf)
+            Gg[g] += np.einsum("sif,sjf->fij", X, X.conj())
     scale = 2.0 / (fs * np.sum(w ** 2) * n_seg)
     Gg *= scale
     Gg[:, 0] /= 2
     G = Gg.sum(axis=0)
     return np.fft.rfftfreq(2 * nperseg, 1 / fs), G, w, n_seg, (Gg if n_g else None)
+
+
+def _psd_svd(G):
+    """Singular values (descending) and left vectors of stacked Hermitian positive semi-definite
+    matrices, by their eigen-decomposition: for such a matrix the two coincide, and LAPACK's Hermitian
+    solver takes half the time of the general SVD (8 against 16 ms for 2049 lines of 5 outputs).
+    Round-off below zero is clipped: a cross-spectral matrix has no negative power."""
+    lam, V = np.linalg.eigh(G)
+    return V[..., ::-1], np.maximum(lam[..., ::-1], 0.0)
 
 
 def _fdd_nperseg(nperseg, n):
@@ -164,6 +182,7 @@ def _efdd(bell, w, fs, nperseg, power=0):
     fk = k * fs / (2 * (bell.size - 1))
     fn0, z0 = float(est.fn[0]), float(est.zeta[0])
     fn, z = fn0, z0
+    last = None
     for _ in range(BIAS_ITERATIONS):
         # the (fn, zeta) whose exact bell, cut and fitted the same way, gives what the data gave
         exact = np.zeros(bell.size)
@@ -177,9 +196,23 @@ def _efdd(bell, w, fs, nperseg, power=0):
         fn, z = fn + step_f, z + step_z
         if not (z > 0 and abs(z - z0) <= 0.5 * z0):
             return est, end, None   # not a small correction: keep the fit, the caller flags it
-        if abs(step_z) < 1e-3 * z and abs(step_f) < 1e-6 * fn:
+        # converged when what is left moves fn and zeta by under 1 % of the fit's own std (a lower
+        # bound of the jackknife's) or round-off-level amounts, whichever is larger
+        tol_f, tol_z = max(1e-6 * fn, 0.01 * float(est.fn_std[0])), max(1e-3 * z, 0.01 * float(est.zeta_std[0]))
+        if abs(step_z) < tol_z and abs(step_f) < tol_f:
             break
+        if last is not None and _remaining(step_z, last[1]) < tol_z and _remaining(step_f, last[0]) < tol_f:
+            break   # the steps contract: what is left is below the tolerance without another fit
+        last = (step_f, step_z)
     return dataclasses.replace(est, fn=np.array([fn]), zeta=np.array([z])), end, (fn0 - fn, z0 - z)
+
+
+def _remaining(step, previous):
+    """What a fixed-point iteration has still to go after ``step``: with the contraction rho =
+    |step / previous| < 1 the error is at most rho / (1 - rho) |step| (inf when the steps do not
+    contract)."""
+    rho = abs(step) / abs(previous) if previous else np.inf
+    return rho / (1 - rho) * abs(step) if rho < 1 else np.inf
 
 
 def _efdd_fit(bell, w, fs, nperseg, end=None, poles=None):
@@ -290,7 +323,7 @@ def oma_fdd(rec, *, band=None, nperseg: int | None = None, channels=None, n_mode
     if not 0 < mac_bell < 1:
         raise ParameterError(f"mac_bell={mac_bell!r} must be between 0 and 1")
     f, G, w, n_seg, Gg = _csd_matrix(Y, rec.fs, nper)
-    U, S, _ = np.linalg.svd(G)
+    U, S = _psd_svd(G)
     sel = (f >= band[0]) & (f <= band[1])
     picked, rejected = _fdd_peaks(f, S, U, sel, float(min_prominence_db), rec.fs / nper, n_modes, OutputSpectra(Y),
                                   rec.fs)
@@ -311,7 +344,7 @@ def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end, poles):
     tot = Gg[:, lo:hi].sum(axis=0)
     ref = U[c["line"], :, c["sv"]]
     vals = []
-    U_all, S_all, _ = np.linalg.svd(tot[None] - Gg[:, lo:hi])     # every replicate in one call
+    U_all, S_all = _psd_svd(tot[None] - Gg[:, lo:hi])     # every replicate in one call
     for g in range(Gg.shape[0]):
         Ur, Sr = U_all[g], S_all[g]
         k = int(np.argmax([mac_pair(Ur[c["line"] - lo, :, j], ref) for j in range(Sr.shape[1])]))
