@@ -157,7 +157,8 @@ def _order_tracked_job(job: Job, tracked: dict, band):
 
 
 def _fast_len_below(n: int) -> int:
-    """The largest length <= n whose prime factors are 2, 3 and 5 (at most ~1 % shorter above 1000)."""
+    """The largest length <= n whose prime factors are 2, 3 and 5 (at most 4 % shorter from 10^4 samples
+    on, 2.8 % from 10^5: measured over every length)."""
     from scipy.fft import next_fast_len
     m = n
     while m > 1 and next_fast_len(m, real=True) != m:
