@@ -351,3 +351,25 @@ def test_ssi_narrow_low_band_decimates_no_further_than_the_record_allows():
     np.testing.assert_allclose(narrow.fn, wide.fn[:3], rtol=0.005)
     assert np.all(np.abs(narrow.zeta - wide.zeta[:3]) < 2 * np.hypot(narrow.zeta_std, wide.zeta_std[:3]))
     np.testing.assert_allclose(whole.zeta[:4], wide.zeta, atol=1e-12)
+
+
+def test_the_psd_decomposition_equals_the_svd_of_a_cross_spectral_matrix():
+    # oracle: numpy's general SVD; for a Hermitian positive semi-definite matrix the eigen-decomposition
+    # gives the same singular values (descending) and the same vectors up to a phase (|v_eig^H u_svd| = 1
+    # where the singular values are distinct); tolerance: round-off of 5 x 5 double-precision LAPACK
+    from vibmeasure.identify.oma.fdd import _psd_svd
+    rng = np.random.default_rng(4)
+    A = rng.standard_normal((64, 5, 12)) + 1j * rng.standard_normal((64, 5, 12))
+    G = A @ A.conj().transpose(0, 2, 1)
+    U, S = _psd_svd(G)
+    U0, S0, _ = np.linalg.svd(G)
+    np.testing.assert_allclose(S, S0, rtol=1e-12)
+    np.testing.assert_allclose(np.abs(np.einsum("fik,fik->fk", U.conj(), U0)), 1.0, atol=1e-9)
+
+
+def test_the_bias_iteration_stops_on_the_contraction_of_its_steps():
+    # oracle: a fixed-point iteration contracting by rho has at most rho / (1 - rho) x the last step to go
+    from vibmeasure.identify.oma.fdd import _remaining
+    assert _remaining(0.01, 0.1) == pytest.approx(0.1 / 0.9 * 0.01, rel=1e-12)
+    assert _remaining(-0.01, 0.1) == pytest.approx(0.1 / 0.9 * 0.01, rel=1e-12)   # alternating steps alike
+    assert _remaining(0.2, 0.1) == np.inf and _remaining(0.01, 0.0) == np.inf      # no contraction: no claim
