@@ -86,8 +86,9 @@ def band_kurtosis(Y, fs, f0, half_width, shape=None) -> float:
     f = np.fft.rfftfreq(sp.n_fft, 1 / fs)
     X[np.abs(f - f0) > half_width] = 0
     x = np.fft.irfft(X, sp.n_fft)[n // 10: n - n // 10]
-    p2 = np.mean(x ** 2)
-    return float(np.mean(x ** 4) / p2 ** 2) if p2 > 0 else float("nan")
+    x2 = x * x   # (x ** 4 is a pow call per sample: 5x slower than squaring twice)
+    p2 = np.mean(x2)
+    return float(np.mean(x2 * x2) / p2 ** 2) if p2 > 0 else float("nan")
 
 
 def harmonic_by_kurtosis(kurt: float, half_width: float, duration: float) -> bool:

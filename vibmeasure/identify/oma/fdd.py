@@ -150,14 +150,14 @@ def _bell(S, U, cand, mac_bell):
     best = np.argmax(mac, axis=1)
     ok = mac[np.arange(mac.shape[0]), best] >= mac_bell
     bell = np.zeros(S.shape[0])
-    lines = []
-    for step in (-1, 1):
-        i = cand["line"] if step == 1 else cand["line"] - 1
-        while 0 <= i < S.shape[0] and ok[i]:
-            bell[i] = S[i, best[i]]
-            lines.append(i)
-            i += step
-    return bell, sorted(lines)
+    at = cand["line"]
+    stop = np.flatnonzero(~ok[at:])                  # the first line from the peak up that does not match
+    hi = at + (int(stop[0]) if stop.size else ok.size - at)
+    start = np.flatnonzero(~ok[:at])                 # the last line below the peak that does not match
+    lo = int(start[-1]) + 1 if start.size else 0
+    lines = np.arange(lo, hi)
+    bell[lines] = S[lines, best[lines]]
+    return bell, lines.tolist()
 
 
 UNRESOLVED_DB_OVER_FLOOR = 100.0   # 20 dB: an incoherent peak this far over the noise is close modes, not noise
