@@ -64,6 +64,13 @@ def test_the_database_store_keeps_the_hdf5_stores_contract(target, tmp_path):
     for col in ("measurement", "asset", "point", "top", "confidence", "params", "result"):
         assert r_ref[col].tolist() == r[col].tolist(), col
     assert np.isnan(r["v"].iloc[1]) and r["v"].iloc[0] == 1.0
+    # a trend reads the summary only: the same frame without the result documents, on both stores
+    for store, full in ((ref, r_ref), (st, r)):
+        lean = store.results("diagnose", with_result=False)
+        assert "result" not in lean and lean.columns.tolist() == full.drop(columns="result").columns.tolist()
+        assert lean["confidence"].tolist() == full["confidence"].tolist()
+        with pytest.raises(vm.ParameterError, match="with_result='no' must be True or False"):
+            store.results("diagnose", with_result="no")
     assert np.array_equal(st.record("m0000002").data, ref.record("m0000002").data)
     sha = m["sha256"].iloc[2]
     assert st.has(sha) == "m0000003" and st.has("0" * 64) is None

@@ -290,3 +290,11 @@ def select_names(available, wanted, *, source: str) -> list[int]:
         else:
             raise ParameterError(f"channels={wanted!r}: {w!r} is not in {source}; it has {available}")
     return out
+
+
+def check_flag(value, name: str) -> bool:
+    """A yes/no option: True or False (numpy's bool too), never a truthy string or number that would
+    mean what the caller did not say."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"{name}={value!r} must be True or False")
+    return bool(value)

@@ -7,6 +7,7 @@ import json
 import numpy as np
 
 from ..core.errors import ParameterError
+from ..core._validate import check_flag
 from ._store_common import ALARM_COLUMNS, TASK_ALIASES, _hash_key, _seconds, check_row
 
 
@@ -146,7 +147,8 @@ class _Queries:
         """
         return self._timed(self._frame("measurements", asset=asset, point=point), since, until)
 
-    def results(self, task: str, asset: str | None = None, point: str | None = None, since=None, until=None):
+    def results(self, task: str, asset: str | None = None, point: str | None = None, since=None, until=None,
+                *, with_result: bool = True):
         """Results of one task as a DataFrame, oldest first.
 
         Parameters
@@ -157,6 +159,9 @@ class _Queries:
             Only these.
         since, until : float, str or datetime, optional
             Only this time range.
+        with_result : bool
+            False leaves out the ``result`` column: a trend needs the summary values only, and over a
+            year of a busy store the full documents are most of the query's time.
 
         Returns
         -------
@@ -168,7 +173,7 @@ class _Queries:
         Raises
         ------
         ParameterError
-            For a bad time.
+            For a bad time, or a ``with_result`` that is not True or False.
 
         Examples
         --------
@@ -186,6 +191,7 @@ class _Queries:
         ['none']
         """
         import pandas as pd
+        check_flag(with_result, "with_result")
         task = TASK_ALIASES.get(task, task)
         meas = {r["id"]: (r["asset"], r["point"], r["time"]) for r in self._each("measurements")}
         flat = []
@@ -197,7 +203,7 @@ class _Queries:
                 continue
             flat.append({"measurement": r["measurement"], "asset": a, "point": p, "time": t, "task": r["task"],
                          "version": r["version"], "params": r.get("params", {}), **r.get("summary", {}),
-                         "result": r.get("result")})
+                         **({"result": r.get("result")} if with_result else {})})
         df = pd.DataFrame(flat)
         if df.empty:
             return pd.DataFrame(columns=["measurement", "asset", "point", "time", "task", "version", "params"])

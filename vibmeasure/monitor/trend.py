@@ -104,7 +104,9 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
         raise ParameterError(f"baseline_count={baseline_count!r} must be an integer >= 2")
     rows = []
     # one row per measurement: a measurement analysed again counts once, by its latest result
-    frames = {task: st.results(task, asset=asset, point=point) for task in dict.fromkeys(t for t, *_ in METRICS)}
+    # (the summary values only: the full result documents are most of a long history's query time)
+    frames = {task: st.results(task, asset=asset, point=point, with_result=False)
+              for task in dict.fromkeys(t for t, *_ in METRICS)}
     rows += _diagnosis_rows(frames.get("diagnose"))
     for task, col, direction, kind, fw, fa in METRICS:
         df = frames[task]
@@ -221,8 +223,8 @@ def metric_history(store, *, asset: str, point: str, metric: str, task: str | No
     tasks = [t for t, c, *_ in METRICS if c == metric and (task is None or t == task)]
     if not tasks:
         raise ParameterError(f"metric={metric!r} is not trended; one of {sorted({c for _, c, *_ in METRICS})}")
-    df = next((d for d in (st.results(t, asset=asset, point=point) for t in tasks) if not d.empty and metric in d),
-              None)
+    found = (st.results(t, asset=asset, point=point, with_result=False) for t in tasks)
+    df = next((d for d in found if not d.empty and metric in d), None)
     if df is None:
         raise ParameterError(f"no {metric} results for {asset}/{point} in the store")
     tr = trend(st, asset=asset, point=point, baseline_count=baseline_count)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ...core.errors import ParameterError
+from ...core._validate import check_flag
 from .._store_common import ALARM_COLUMNS, TASK_ALIASES, _seconds
 from .schema import _RAW_KEY, _loads, _many, _mid, _mnum, _tables
 
@@ -104,10 +105,12 @@ class _SQLQueries:
         df["time"] = pd.to_datetime(df["time"], unit="s", utc=True)
         return df
 
-    def results(self, task: str, asset: str | None = None, point: str | None = None, since=None, until=None):
+    def results(self, task: str, asset: str | None = None, point: str | None = None, since=None, until=None,
+                *, with_result: bool = True):
         """Results of one task as a DataFrame, oldest first (``Store.results``): measurement, asset, point,
-        time, task, version, params, the summary values as columns and ``result``; one row per
-        measurement, its latest result of the task.
+        time, task, version, params, the summary values as columns and ``result`` (left out with
+        ``with_result=False``: the documents are not read); one row per measurement, its latest result
+        of the task.
 
         Examples
         --------
@@ -125,8 +128,10 @@ class _SQLQueries:
         t = _tables()
         r, m = t["results"], t["measurements"]
         task = TASK_ALIASES.get(task, task)
+        check_flag(with_result, "with_result")
+        doc = r.c.result if with_result else sa.null()
         stmt = (sa.select(r.c.measurement, m.c.asset, m.c.point, m.c.time, r.c.task, r.c.version, r.c.params,
-                          r.c.summary, r.c.result, m.c.id).join(m, r.c.measurement == m.c.id)
+                          r.c.summary, doc, m.c.id).join(m, r.c.measurement == m.c.id)
                 .where(r.c.task == task))
         if task == "error":   # an error a later analysis of the same measurement succeeded past is gone
             r2 = r.alias("later")
@@ -144,7 +149,8 @@ class _SQLQueries:
         # the summary's values as columns (one JSON parse for all rows: 8,760 rows in 0.1 s, not 0.3)
         summary = pd.DataFrame(_many(cols[7], {}), index=df.index)
         df = pd.concat([df, summary.drop(columns=[c for c in summary if c in df])], axis=1)
-        df["result"] = _many(cols[8], None)
+        if with_result:
+            df["result"] = _many(cols[8], None)
         # a measurement analysed again: its latest result of the task replaces the earlier ones
         df = df.drop_duplicates("measurement", keep="last").reset_index(drop=True)
         df["time"] = pd.to_datetime(df["time"], unit="s", utc=True)
