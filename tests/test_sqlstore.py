@@ -11,6 +11,7 @@ import textwrap
 import time
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import vibmeasure as vm
@@ -31,6 +32,30 @@ def _fill(st, n=3, raw=True):
                       summary={"top": "none", "confidence": 0.5 + 0.1 * i, "v": float("nan") if i == 1 else 1.0})
         ids.append(mid)
     return ids
+
+
+def test_results_of_several_tasks_from_one_query_are_each_tasks_own_frame(target, tmp_path):
+    """What a trend reads in one query (every trended task at once) is, task by task, exactly the frame
+    ``results`` gives for that task alone: its own summary columns, its latest result per measurement,
+    an error a later success replaced left out on the database store as before."""
+    url, raw_dir = target
+    for store_target in (tmp_path / "ref.h5", url):
+        with vm.Store(store_target, writable=True, **({"raw_dir": raw_dir} if store_target == url else {})) as st:
+            ids = _fill(st, raw=False)
+            st.add_result(ids[0], "spectrum", {"rms": 2.0}, summary={"rms": 2.0, "peak_hz": 50.0})
+            st.add_result(ids[1], "error", {"task": "spectrum", "message": "x"}, summary={"failed_task": "spectrum"})
+            st.add_result(ids[1], "spectrum", {"rms": 3.0}, summary={"rms": 3.0})
+            st.add_result(ids[2], "diagnose", {"top": "looseness"}, summary={"top": "looseness", "confidence": 0.9})
+        st = vm.Store(store_target, **({"raw_dir": raw_dir} if store_target == url else {}))
+        tasks = ["diagnosis", "spectrum", "error", "ringdown"]
+        for lean in (True, False):
+            frames = st._results_by_task(tasks, asset="pump-1", with_result=not lean)
+            assert sorted(frames) == ["diagnose", "error", "ringdown", "spectrum"]
+            for task, df in frames.items():
+                pd.testing.assert_frame_equal(df, st.results(task, asset="pump-1", with_result=not lean))
+        assert frames["diagnose"]["top"].tolist() == ["none", "none", "looseness"]
+        assert frames["spectrum"]["rms"].tolist() == [2.0, 3.0] and "top" not in frames["spectrum"]
+        assert frames["ringdown"].empty
 
 
 @pytest.fixture(params=["sqlite", "postgresql"])

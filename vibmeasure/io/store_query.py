@@ -214,6 +214,11 @@ class _Queries:
                 df = df[df[k] == v]
         return self._timed(df.reset_index(drop=True), since, until)
 
+    def _results_by_task(self, tasks, asset=None, point=None, since=None, until=None, *, with_result=True) -> dict:
+        """{task: its ``results`` frame} for several tasks (the database store answers from one query)."""
+        keys = dict.fromkeys(TASK_ALIASES.get(k, k) for k in tasks)
+        return {k: self.results(k, asset, point, since, until, with_result=with_result) for k in keys}
+
     def alarms(self, asset: str | None = None, point: str | None = None):
         """The alarm history, which only a database store keeps (``vm.Store("plant.db")``): an HDF5 store
         returns it empty, with the database's columns; ``vm.trend`` gives its current verdicts.

@@ -105,8 +105,7 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
     rows = []
     # one row per measurement: a measurement analysed again counts once, by its latest result
     # (the summary values only: the full result documents are most of a long history's query time)
-    frames = {task: st.results(task, asset=asset, point=point, with_result=False)
-              for task in dict.fromkeys(t for t, *_ in METRICS)}
+    frames = st._results_by_task([t for t, *_ in METRICS], asset=asset, point=point, with_result=False)
     rows += _diagnosis_rows(frames.get("diagnose"))
     for task, col, direction, kind, fw, fa in METRICS:
         df = frames[task]

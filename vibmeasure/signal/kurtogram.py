@@ -18,6 +18,7 @@ from scipy import fft as _fft
 from ..core._validate import as_record, clean_signal, positive, response_channel
 from ..core.errors import ParameterError
 from ..core.results import Kurtogram
+from .spectral import symmetric_window
 
 __all__ = ["kurtogram", "Kurtogram", "band_ses", "kurtogram_of", "ses_power"]
 
@@ -187,7 +188,7 @@ def ses_power(X: np.ndarray, n: int, fs: float, band: tuple, f_max: float) -> tu
     L = _fft.next_fast_len(2 * m)           # room for the squared envelope's doubled bandwidth
     c = _complex_envelope(X, k0, k1, n, L)
     e = np.abs(c) ** 2
-    w = np.hanning(L)
+    w = symmetric_window("hann", L)
     E = _fft.rfft((e - e.mean()) * w)
     k_max = min(E.size - 1, int(np.ceil(f_max * n / fs)) + 2)
     freq = np.arange(k_max + 1) * (fs / n)

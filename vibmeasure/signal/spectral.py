@@ -22,7 +22,7 @@ from ..core.errors import ParameterError
 from ..core.results import Spectrogram, Spectrum
 from .segments import _ArraySource, segment_sums
 
-__all__ = ["amplitude_spectrum", "psd", "csd", "coherence", "spectrogram", "power_unit", "get_window", "segment_sums", "check_segment_params"]
+__all__ = ["amplitude_spectrum", "psd", "csd", "coherence", "spectrogram", "power_unit", "get_window", "segment_sums", "check_segment_params", "symmetric_window"]
 
 MEDIAN_LIMIT = 20_000_000  # per-segment values kept for median averaging
 
@@ -63,6 +63,29 @@ def get_window(window, n: int) -> np.ndarray:
 @functools.lru_cache(maxsize=32)
 def _named_window(window, n: int) -> np.ndarray:
     return _sig.get_window(window, n, fftbins=True)
+
+
+def symmetric_window(window: str, n: int) -> np.ndarray:
+    """A symmetric window of length n ("hann": np.hanning's; else scipy's with fftbins=False), read-only.
+
+    One diagnosis windows the same record length a dozen times; records up to 2^20 samples keep their
+    last four windows (32 MiB at most), longer ones are computed each time.
+
+    Examples
+    --------
+    >>> from vibmeasure.signal.spectral import symmetric_window
+    >>> w = symmetric_window("hann", 5)
+    >>> w.tolist(), w.flags.writeable
+    ([0.0, 0.5, 1.0, 0.5, 0.0], False)
+    """
+    return _symmetric(window, int(n)) if n <= 2 ** 20 else _symmetric.__wrapped__(window, int(n))
+
+
+@functools.lru_cache(maxsize=4)
+def _symmetric(window: str, n: int) -> np.ndarray:
+    w = np.hanning(n) if window == "hann" else _sig.get_window(window, n, fftbins=False)
+    w.flags.writeable = False
+    return w
 
 
 def _check_dtype(dtype):

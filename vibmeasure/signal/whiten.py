@@ -51,9 +51,23 @@ def measured_top(X: np.ndarray, fs: float, n: int) -> float:
     # the typical level under j: the median of the bands below (the pass band, as long as it is the
     # larger part), on every 4th band
     js = np.arange(8, nb, 4)
-    below = np.array([np.median(L[:j]) for j in js])
+    below = _prefix_medians(L, js)
     dead = np.flatnonzero(top_max[js] < below - DEAD_DB)
     return fs / 2 if not dead.size else float(edges[js[dead[0]]]) * fs / n
+
+
+def _prefix_medians(L: np.ndarray, js: np.ndarray) -> np.ndarray:
+    """np.median(L[:j]) for each rising j in js: the prefix kept sorted as it grows (one insertion per
+    value, not a partition of the whole prefix for every j)."""
+    from bisect import insort
+    vals, out, n = [], [], 0
+    for j in js.tolist():
+        for v in L[n:j].tolist():
+            insort(vals, v)
+        n = j
+        mid = j // 2
+        out.append(vals[mid] if j % 2 else (vals[mid - 1] + vals[mid]) / 2)
+    return np.array(out)
 
 
 def cepstral_spectrum(X: np.ndarray, k_top: int | None = None) -> np.ndarray:

@@ -3,6 +3,8 @@ p-values to posterior confidence."""
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from .rules import PRIOR_ODDS, R_CAP, SHAFT_PRECISION, SLIP
@@ -36,13 +38,28 @@ def _log_p_to_conf(logp: np.ndarray) -> np.ndarray:
 
 def _positions(f0, harmonics, side, s):
     """Line positions (n_slip, n_terms) and the (harmonic, sideband) label of each term."""
-    h = np.asarray(harmonics, float)
-    sb = (-1, 0, 1) if side else (0,)
-    terms = [(hh, k) for hh in h for k in sb]
-    H = np.array([t[0] for t in terms])
-    K = np.array([t[1] for t in terms])
+    H, K, terms = _terms(tuple(harmonics), bool(side))
     sp = 0.0 if side is None else side[0] * (1 + s[:, None] * side[1])
     return H * f0 * (1 + s[:, None]) + K * sp, terms
+
+
+@lru_cache(maxsize=256)
+def _terms(harmonics: tuple, sidebands: bool):
+    """The comb's terms: each harmonic alone or with its -1, 0, +1 sidebands; (harmonic array, sideband
+    array, [(harmonic, sideband)]). Cached: a diagnosis asks for the same few shapes thousands of times."""
+    terms = [(hh, k) for hh in np.asarray(harmonics, float) for k in ((-1, 0, 1) if sidebands else (0,))]
+    H = np.array([t[0] for t in terms])
+    K = np.array([t[1] for t in terms])
+    H.flags.writeable = K.flags.writeable = False
+    return H, K, tuple(terms)
+
+
+@lru_cache(maxsize=256)
+def _slip_grid(slip: float, n_s: int) -> np.ndarray:
+    """The common slips a comb is tried at (read-only, cached like the terms)."""
+    s = np.linspace(-slip, slip, n_s)
+    s.flags.writeable = False
+    return s
 
 
 def _best(vals: np.ndarray, n_t: int, m_eff: int, shape: float):
@@ -54,8 +71,9 @@ def _best(vals: np.ndarray, n_t: int, m_eff: int, shape: float):
     return T, j, np.log(m_eff) + n_t * np.log(2.0) + _log_gamma_sf(float(T[j]) * shape, n_t * shape)
 
 
-def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
-    """Best common slip for a comb and its log p-value; None when fewer than 2 terms fit the SES."""
+def _comb_fit(ses: _SES, f0: float, harmonics, side=None, slip=SLIP):
+    """The comb's fit over the common slips: (harmonics that fit the SES, slips, positions, terms,
+    line values, statistics, best row, log p-value), or None when fewer than 2 terms fit."""
     df = ses.freq[1]
     top = (max(harmonics) * f0 + (side[0] if side else 0.0)) * (1 + slip)
     if top / df >= ses.n_valid - 2:
@@ -64,24 +82,38 @@ def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
         if len(harmonics) < (1 if side else 2):
             return None
         top = (max(harmonics) * f0 + (side[0] if side else 0.0)) * (1 + slip)
-    n_s = max(3, int(np.ceil(2 * slip * top / (0.5 * df))) + 1)
-    s = np.linspace(-slip, slip, n_s)
+    s = _slip_grid(slip, max(3, int(np.ceil(2 * slip * top / (0.5 * df))) + 1))
     pos, terms = _positions(f0, harmonics, side, s)
-    b = np.clip(pos / df, 1, ses.n_valid - 2)
-    i0 = b.astype(np.int64)
+    i0 = np.clip(pos / df, 1, ses.n_valid - 2).astype(np.int64)
     vals = np.maximum(ses.r[i0], ses.r[i0 + 1])
-    n_t = len(terms)
-    T, j, logp = _best(vals, n_t, int(2 * slip * top / df) + 1, ses.shape)
-    lines = [{"harmonic": float(h), "sideband": int(k), "hz": float(p), "r": float(v)}
-             for (h, k), p, v in zip(terms, pos[j], vals[j])]
-    carriers = [v for (h, k), v in zip(terms, vals[j]) if k == 0]
-    return {"logp": float(min(logp, 0.0)), "slip": float(s[j]), "stat": float(T[j]), "n_terms": n_t,
+    T, j, logp = _best(vals, len(terms), int(2 * slip * top / df) + 1, ses.shape)
+    return harmonics, s, pos, terms, vals, T, j, logp
+
+
+def _comb_logp(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> float | None:
+    """The comb's log p-value alone (``_comb(...)["logp"]``), for the many decoy combs that need no more."""
+    fit = _comb_fit(ses, f0, harmonics, side, slip)
+    return None if fit is None else float(min(fit[-1], 0.0))
+
+
+def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
+    """Best common slip for a comb and its log p-value; None when fewer than 2 terms fit the SES."""
+    fit = _comb_fit(ses, f0, harmonics, side, slip)
+    if fit is None:
+        return None
+    harmonics, s, pos, terms, vals, T, j, logp = fit
+    n_s = s.size
+    best = vals[j].tolist()
+    standing = [v >= ses.r_line for v in best]
+    lines = [{"harmonic": float(h), "sideband": int(k), "hz": float(p), "r": v}
+             for (h, k), p, v in zip(terms, pos[j].tolist(), best)]
+    return {"logp": float(min(logp, 0.0)), "slip": float(s[j]), "stat": float(T[j]), "n_terms": len(terms),
             "edge": bool(j in (0, n_s - 1) and T[j] > T[n_s // 2]),
-            "strength": float(np.sum(carriers)),
-            "lines": lines, "n_lines": int(sum(v >= ses.r_line for v in vals[j])),
-            "n_carriers": int(sum(v >= ses.r_line for (h, k), v in zip(terms, vals[j]) if k == 0 and h <= 3)),
-            "n_odd": int(sum(v >= ses.r_line for (h, k), v in zip(terms, vals[j]) if h != int(h) or int(h) % 2)),
-            "step": _step(h for (h, k), v in zip(terms, vals[j]) if v >= ses.r_line),
+            "strength": float(np.sum([v for (h, k), v in zip(terms, vals[j]) if k == 0])),
+            "lines": lines, "n_lines": int(sum(standing)),
+            "n_carriers": int(sum(bool(st and k == 0 and h <= 3) for (h, k), st in zip(terms, standing))),
+            "n_odd": int(sum(bool(st and (h != int(h) or int(h) % 2)) for (h, k), st in zip(terms, standing))),
+            "step": _step(h for (h, k), st in zip(terms, standing) if st),
             "halves": _halves(ses, f0 * (1 + s[j]), harmonics)}
 
 
@@ -106,7 +138,9 @@ def _halves(ses: _SES, f0: float, harmonics, base: bool = False) -> int:
     own = [v for v in (height(h * f0) for h in (1, 2, 3)) if v >= ses.r_line]
     if not own:
         return 0
-    need = max(ses.r_line, HALF_SHARE * float(np.median(own)))
+    own.sort()   # their median, as np.median takes it, without its overhead on three values
+    mid = len(own) // 2
+    need = max(ses.r_line, HALF_SHARE * (own[mid] if len(own) % 2 else (own[mid - 1] + own[mid]) / 2))
     return sum(height((h - 0.5) * f0) >= need for h in (1, 2, 3) if (h - 0.5) * f0 / df >= 2)
 
 

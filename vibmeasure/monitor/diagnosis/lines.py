@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import fft as _sfft
 
+from ...signal.spectral import symmetric_window
+
 if TYPE_CHECKING:   # for annotations only
     from .job import Job
 
@@ -33,13 +35,24 @@ def _spectrum(job: Job, window="hann"):
     """Amplitude spectrum of the primary channel (acceleration) and the velocity spectrum from it.
     Hann for lines; Blackman-Harris (sidelobes below -92 dB) where the floor beside a strong line
     is measured, so the line's own leakage is not taken for a raised floor."""
-    from scipy.signal import get_window
+    last = _LAST["spectrum"]   # one snapshot: another thread may replace it meanwhile
+    if last is not None and last[0] is job.a and last[1] == (job.fs, window):
+        return last[2]
     n = job.a.size
-    win = np.hanning(n) if window == "hann" else get_window(window, n, fftbins=False)
+    win = symmetric_window(window, n)
     A = np.abs(_sfft.rfft((job.a - job.a.mean()) * win)) * 2 / win.sum()   # scipy's: 2x numpy's at awkward n
     f = np.fft.rfftfreq(n, 1 / job.fs)
     V = np.where(f > 0, A / (2 * np.pi * np.maximum(f, 1e-12)), 0.0)  # velocity amplitude
+    for arr in (f, A, V):
+        arr.flags.writeable = False
+    _LAST["spectrum"] = (job.a, (job.fs, window), (f, A, V))
     return f, A, V
+
+
+# The speed step and the shaft-order step ask for the same primary channel's spectrum when no supply
+# line is taken out of it: the last one is kept (read-only), keyed on the very array it was taken of
+# (a job's arrays are never changed in place; a new one replaces them).
+_LAST: dict = {"spectrum": None}
 
 
 def _lines_standing(f, A, k, need):

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import fft as _sfft
 
+from ...signal.spectral import symmetric_window
 from .job import Job
 from .lines import LINE_DB, _harmonic_support, _line, _lines_standing, _spectrum
 from .mains import _at_mains
@@ -128,7 +129,7 @@ def _contradiction(job: Job, f, A, found, snr1):
     for name, x in job.signals.items():
         if name == job.primary or x.size != job.a.size:
             continue
-        win = np.hanning(x.size)
+        win = symmetric_window("hann", x.size)
         Ax = np.abs(_sfft.rfft((x - x.mean()) * win)) * 2 / win.sum()
         found_x = _one_x(f, Ax, f1, job.mains)
         snr_x = found_x[1] if found_x else _line(f, Ax, f1, max(SPEED_SEARCH * f1, 2 * f[1]), f1 + 5 * f[1])[2]
