@@ -86,6 +86,21 @@ def test_comb_recovers_the_common_slip(rng):
     assert res["logp"] == pytest.approx(expected, abs=1e-6)
 
 
+def test_the_decoys_combs_scored_in_one_array_are_each_combs_own(rng):
+    # the decoy p-value's 120 combs are fitted in one array; each log p must be the one that comb gets
+    # alone, to the last bit (the same arithmetic row by row), with and without sidebands, and for the
+    # combs that reach the spectrum's end (fitted alone on the harmonics that fit)
+    r = rng.exponential(size=6000)
+    r[rng.integers(0, 6000, 40)] *= 25.0
+    ses = _ses(r, 0.25)
+    f0s = list(np.geomspace(60.0, 700.0, 120))
+    assert 3 * f0s[-1] * (1 + bf.SLIP) / 0.25 >= ses.n_valid - 2   # the last combs of 1-3 x f0 reach the end
+    for harmonics, side in (((1, 2, 3), None), ((1, 2, 3), (29.95, 1.0)), ((0.5, 1, 1.5), None)):
+        many = bf._comb_logps(ses, f0s, harmonics, side)
+        alone = [None if c is None else c["logp"] for c in (bf._comb(ses, f0, harmonics, side) for f0 in f0s)]
+        assert many == alone
+
+
 def test_a_comb_that_fits_best_at_the_edge_of_the_slip_range_is_not_called(rng):
     # a comb of broad lines (skirts falling e-fold in 20 bins, as a line smeared by speed changes)
     # 1.3 % from BPFO peaks inside the +-2 % range; placed 2.5 % off, its best slip is the range's edge

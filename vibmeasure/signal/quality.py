@@ -401,10 +401,9 @@ def transients(x, block: int, *, whiten: bool = False) -> list[tuple[int, int]]:
 def _whitened(x: np.ndarray) -> tuple[np.ndarray, int]:
     """x cepstrally whitened (every bin of its spectrum at magnitude 1, none above the band it
     measures), after a Tukey taper of WHITEN_TAPER; and the samples at each end the taper touches."""
-    from scipy.signal.windows import tukey
-    from .whiten import cepstral_spectrum, measured_top
+    from .whiten import cepstral_spectrum, measured_top, tapered_spectrum
     n = x.size
-    X = _fft.rfft((x - x.mean()) * tukey(n, WHITEN_TAPER))
+    X = tapered_spectrum(x, WHITEN_TAPER)
     k_hi = int(np.floor(measured_top(X, 1.0, n) * n))
     return _fft.irfft(cepstral_spectrum(X, k_hi), n), int(np.ceil(WHITEN_TAPER * n / 2))
 

@@ -16,7 +16,7 @@ from ..core._validate import as_record, clean_signal, positive, response_channel
 from ..core.errors import ParameterError
 from ..core.record import Channel, Record
 
-__all__ = ["prewhiten", "remove_synchronous", "measured_top", "cepstral_spectrum", "edit_lines", "ar_residual", "ar_order", "synchronous_part"]
+__all__ = ["tapered_spectrum", "prewhiten", "remove_synchronous", "measured_top", "cepstral_spectrum", "edit_lines", "ar_residual", "ar_order", "synchronous_part"]
 
 _METHODS = ("cepstral", "ar")
 
@@ -68,6 +68,35 @@ def _prefix_medians(L: np.ndarray, js: np.ndarray) -> np.ndarray:
         mid = j // 2
         out.append(vals[mid] if j % 2 else (vals[mid - 1] + vals[mid]) / 2)
     return np.array(out)
+
+
+def tapered_spectrum(x: np.ndarray, taper: float) -> np.ndarray:
+    """rfft of x less its mean under a Tukey window of ``taper`` (read-only).
+
+    The transient check and the bearing spectra both whiten each channel from this spectrum: the last
+    few are kept, keyed on the very array they were taken of (the diagnosis never changes a channel's
+    array in place; a repair makes a new one), so a channel is transformed once.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from vibmeasure.signal.whiten import tapered_spectrum
+    >>> x = np.sin(2 * np.pi * 8 * np.arange(256) / 256)
+    >>> X = tapered_spectrum(x, 0.1)
+    >>> int(np.argmax(np.abs(X))), tapered_spectrum(x, 0.1) is X
+    (8, True)
+    """
+    for arr, tp, X in _TAPERED["last"]:      # one snapshot: another thread may replace it meanwhile
+        if arr is x and tp == taper:
+            return X
+    from scipy.signal.windows import tukey
+    X = _fft.rfft((x - x.mean()) * tukey(x.size, taper))
+    X.flags.writeable = False
+    _TAPERED["last"] = ((x, taper, X),) + _TAPERED["last"][:3]
+    return X
+
+
+_TAPERED: dict = {"last": ()}
 
 
 def cepstral_spectrum(X: np.ndarray, k_top: int | None = None) -> np.ndarray:

@@ -7,7 +7,7 @@ import numpy as np
 
 from .families import _family
 from .families import HALVES
-from .lines import _best, _comb_logp, _halves, _positions, _step
+from .lines import _best, _comb_logps, _halves, _positions, _step
 from .rules import ALPHA, FAMILIES, SLIP
 from .spectra import _SES
 
@@ -28,7 +28,7 @@ def _decoy_p(ses: _SES, res: dict, f0: float, freqs: dict) -> float:
     u = u[keep][:: max(1, keep.sum() // N_DECOYS)][:N_DECOYS]
     saved, ses.r = ses.r, ses.r_base if ses.r_base is not None else ses.r
     try:
-        scores = [c for c in (_comb_logp(ses, f0 * ui, harmonics, sp) for ui in u) if c is not None]
+        scores = [c for c in _comb_logps(ses, [f0 * ui for ui in u], harmonics, sp) if c is not None]
     finally:
         ses.r = saved
     raw = res["logp"] - np.log(res["spec"][2])  # the family's own score before the sub-model correction

@@ -39,8 +39,10 @@ def _log_p_to_conf(logp: np.ndarray) -> np.ndarray:
 def _positions(f0, harmonics, side, s):
     """Line positions (n_slip, n_terms) and the (harmonic, sideband) label of each term."""
     H, K, terms = _terms(tuple(harmonics), bool(side))
-    sp = 0.0 if side is None else side[0] * (1 + s[:, None] * side[1])
-    return H * f0 * (1 + s[:, None]) + K * sp, terms
+    pos = H * f0 * (1 + s[:, None])
+    if side is not None:   # (without sidebands K is all 0: nothing to add)
+        pos = pos + K * (side[0] * (1 + s[:, None] * side[1]))
+    return pos, terms
 
 
 @lru_cache(maxsize=256)
@@ -68,7 +70,12 @@ def _best(vals: np.ndarray, n_t: int, m_eff: int, shape: float):
     placements searched; ``shape``: channels averaged (Gamma(shape) per line under noise)."""
     T = np.minimum(vals, R_CAP).sum(axis=1) + 1e-9 * vals.sum(axis=1)  # ties: the stronger lines
     j = int(np.argmax(T))
-    return T, j, np.log(m_eff) + n_t * np.log(2.0) + _log_gamma_sf(float(T[j]) * shape, n_t * shape)
+    return T, j, _log_p(float(T[j]), n_t, m_eff, shape)
+
+
+def _log_p(t: float, n_t: int, m_eff: int, shape: float) -> float:
+    """log p-value of the best comb statistic t: Gamma tail, 2 bins per term, m_eff placements."""
+    return np.log(m_eff) + n_t * np.log(2.0) + _log_gamma_sf(t * shape, n_t * shape)
 
 
 def _comb_fit(ses: _SES, f0: float, harmonics, side=None, slip=SLIP):
@@ -94,6 +101,38 @@ def _comb_logp(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> float |
     """The comb's log p-value alone (``_comb(...)["logp"]``), for the many decoy combs that need no more."""
     fit = _comb_fit(ses, f0, harmonics, side, slip)
     return None if fit is None else float(min(fit[-1], 0.0))
+
+
+def _comb_logps(ses: _SES, f0s, harmonics, side=None, slip=SLIP) -> list:
+    """``_comb_logp`` of the same comb at many fundamentals (the decoys) in one array: every row's
+    arithmetic as ``_comb_fit`` does it, so each value is the one comb's own. A comb that reaches the
+    spectrum's end (its harmonics cut) is fitted alone."""
+    df, nv = ses.freq[1], ses.n_valid
+    off = side[0] if side else 0.0
+    out, rows = [None] * len(f0s), []
+    for i, f0 in enumerate(f0s):
+        top = (max(harmonics) * f0 + off) * (1 + slip)
+        if top / df >= nv - 2:
+            out[i] = _comb_logp(ses, f0, harmonics, side, slip)
+        else:
+            rows.append((i, f0, _slip_grid(slip, max(3, int(np.ceil(2 * slip * top / (0.5 * df))) + 1)),
+                         int(2 * slip * top / df) + 1))
+    if not rows:
+        return out
+    H, K, terms = _terms(tuple(harmonics), bool(side))
+    S = np.concatenate([s for _, _, s, _ in rows])[:, None]
+    pos = H * np.concatenate([np.full(s.size, f0) for _, f0, s, _ in rows])[:, None] * (1 + S)
+    if side is not None:
+        pos = pos + K * (side[0] * (1 + S * side[1]))
+    i0 = np.clip(pos / df, 1, nv - 2).astype(np.int64)
+    vals = np.maximum(ses.r[i0], ses.r[i0 + 1])
+    T = np.minimum(vals, R_CAP).sum(axis=1) + 1e-9 * vals.sum(axis=1)
+    a = 0
+    for i, _, s, m_eff in rows:
+        j = a + int(np.argmax(T[a: a + s.size]))
+        out[i] = float(min(_log_p(float(T[j]), len(terms), m_eff, ses.shape), 0.0))
+        a += s.size
+    return out
 
 
 def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:

@@ -9,7 +9,8 @@ import numpy as np
 from scipy import fft as _fft
 
 from ...signal.kurtogram import kurtogram_of, ses_power
-from ...signal.whiten import ar_order, ar_residual, cepstral_spectrum, edit_lines, measured_top, synchronous_part
+from ...signal.whiten import (ar_order, ar_residual, cepstral_spectrum, edit_lines, measured_top, synchronous_part,
+                              tapered_spectrum)
 from .rules import R_CAP, R_LINE
 
 
@@ -115,8 +116,7 @@ def _candidates(x, fs, f1, freqs, band, whitening):
     fan-end B021_0 outer race at 1.00). With the record's own bands beside it, a finding in the user's
     band alone needs the single-view evidence (``evidence._one_view``), and one the record's bands
     contradict meets their claims."""
-    from scipy.signal.windows import tukey
-    X = _fft.rfft((x - x.mean()) * tukey(x.size, TAPER))
+    X = tapered_spectrum(x, TAPER)
     f_hi = measured_top(X, fs, x.size)
     k_hi = int(np.floor(f_hi * x.size / fs))
     f_top, min_bw, f_need, f_lo = _limits(fs, f1, freqs, f_hi)
