@@ -75,12 +75,15 @@ FACTOR_WINDOW = 0.06
 FACTOR_WINDOWS = tuple((u * (1 - FACTOR_WINDOW), u * (1 + FACTOR_WINDOW)) for u in (0.5, 2.0))
 
 
-def _scan_comb(ses: _SES, f0: float, harmonics, side, lo: float, hi: float, excluded: float = 0.0):
+def _scan_comb(ses: _SES, f0: float, harmonics, side, lo: float, hi: float, excluded: float = 0.0, pair_max=None):
     """Best comb of f0's harmonics (and sidebands at spacing side[0]) when every line scales with the
     speed, over 1 + lo to 1 + hi times the declared speed, outside +-excluded around it: (log p
-    corrected for the range searched, speed factor, term values, labels), or None."""
+    corrected for the range searched, speed factor, term values, labels), or None. ``pair_max``: the
+    larger of each bin and the next of the spectrum scanned (``_pair_max``), when the caller has it."""
     df = ses.freq[1]
     r = ses.r_base if ses.r_base is not None else ses.r
+    if pair_max is None:
+        pair_max = _pair_max(r)
     off = side[0] if side else 0.0
     harmonics = tuple(h for h in harmonics if (h * f0 + off) * (1 + lo) / df < ses.n_valid - 2)
     if len(harmonics) < (1 if side else 2):
@@ -92,11 +95,17 @@ def _scan_comb(ses: _SES, f0: float, harmonics, side, lo: float, hi: float, excl
     b = pos / df
     i0 = np.clip(b, 1, ses.n_valid - 2).astype(np.int64)
     # a line the spectrum does not reach at that speed counts as absent (the comb keeps its shape)
-    vals = np.where(b < ses.n_valid - 2, np.maximum(r[i0], r[i0 + 1]), 0.0)
+    vals = np.where(b < ses.n_valid - 2, pair_max[i0], 0.0)
     T, j, logp = _best(vals, len(terms), int((hi - lo) * top / df) + 1, ses.shape)
     if j in (0, s.size - 1):   # it would fit better outside the range
         return None
     return float(logp), float(1 + s[j]), vals[j], terms
+
+
+def _pair_max(r: np.ndarray) -> np.ndarray:
+    """max(r[i], r[i + 1]) for every i: a line is read from the two bins around its position, and the
+    speed scan reads a million positions of the same spectrum per record."""
+    return np.maximum(r[:-1], r[1:])
 
 
 def _shaft_like(hz: list, f1: float, search: float, df: float) -> bool:
@@ -143,16 +152,18 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
                     declared = min(declared, res["logp"] + np.log(n_sp))
         finally:
             ses.r = saved
+        pair_max = _pair_max(ses.r_base if ses.r_base is not None else ses.r)   # the scans below only read it
         for name, (key, models) in FAMILIES.items():
             for harmonics, side in models:
                 sp = None if side is None else (f1 if side == "1X" else freqs["FTF"],)
                 # within the 1X search a comb only says the speed is somewhat off (the declared speed
                 # stands, as with a 1X found there): it counts for the declared speed
-                near = _scan_comb(ses, freqs[key], harmonics, sp, -speed_search, speed_search)
+                near = _scan_comb(ses, freqs[key], harmonics, sp, -speed_search, speed_search, pair_max=pair_max)
                 if near is not None and _halves(ses, freqs[key] * near[1], harmonics, base=True) < HALVES:
                     declared = min(declared, near[0] + np.log(len(models)) + np.log(n_sp))
                 for lo, hi in ranges:
-                    res = _scan_comb(ses, freqs[key], harmonics, sp, lo - 1.0, hi - 1.0, max(SLIP, speed_search))
+                    res = _scan_comb(ses, freqs[key], harmonics, sp, lo - 1.0, hi - 1.0, max(SLIP, speed_search),
+                                     pair_max=pair_max)
                     if res is None:
                         continue
                     c = _scanned(res, ses, freqs, key, harmonics, side, sp, f1, speed_search,
