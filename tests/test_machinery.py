@@ -1123,6 +1123,25 @@ def test_a_record_read_at_half_its_rate_is_noticed_by_its_half_order_line(shared
     assert loose.top == "looseness" and "speed_inconsistent" not in loose.flags
 
 
+def test_a_half_order_as_high_as_the_1x_is_said_to_be_ambiguous(shared_data):
+    """CWRU fan-end B007_1 (ball) read at half its rate: its 0.5X (the true 1X) stands 0.4 dB under its
+    "1X" (the true 2X), as a loose machine's sub-harmonic does; the answer, undetermined, carried no flag.
+    Within 6 dB of the 1X the half-order is flagged half_order_ambiguous with advice (check fs and the
+    speed) and the answer stands; at its own rate (0.5X 10 dB or more under the 1X) no such flag."""
+    rec = vm.read(shared_data("cwru_fe/B007_1.mat"), fs=12000, unit="g")
+    fe = next(n for n in rec.names if n.endswith("_FE_time"))
+    half = vm.Record.from_array(rec.data, fs=rec.fs / 2, names=list(rec.names), unit="g")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        d = vm.diagnose(half, rpm=rec.meta["rpm"], bearing="6203-2RS", channel=fe)
+        own = vm.diagnose(rec, rpm=rec.meta["rpm"], bearing="6203-2RS", channel=fe)
+    assert "half_order_ambiguous" in d.flags and "speed_inconsistent" not in d.flags
+    assert "fs is 2x the declared 6000 Hz" in d.reason and "check both" in d.reason
+    assert "half_order_ambiguous" not in own.flags and own.top == "bearing_ball"
+    loose = vm.diagnose(vm.synth.machine(fault="looseness", seed=1, duration=4.0), rpm=1797, bearing="6205-2RS")
+    assert loose.top == "looseness" and loose.confidence > 0.9 and "half_order_ambiguous" in loose.flags
+
+
 def test_an_answer_at_a_speed_nothing_confirms_is_held(shared_data):
     """CWRU fan-end IR021_0 (inner race) with its sampling rate declared 4x too high: no line stands within
     12 % of the declared 1X, and the true shaft's harmonics fall where the 6203's 2 x BSF harmonics

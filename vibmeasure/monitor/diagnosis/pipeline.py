@@ -175,7 +175,7 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
                    f"shows whether they matter cannot be computed (give unit=, e.g. 'g'); strongest pattern "
                    f"{unweighed[0]} at score {unweighed[1]:.2f}")
     if {"speed_inconsistent", "speed_contradicted", "order_tracked", "speed_varies",
-            "speed_corrected"} & set(job.flags):
+            "speed_corrected", "half_order_ambiguous"} & set(job.flags):
         reason += "; " + speed["note"]
     if narrow:
         reason += ("; " + ", ".join(f"{k} measures only up to {v:.0f} Hz" for k, v in narrow)

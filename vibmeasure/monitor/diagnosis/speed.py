@@ -30,6 +30,11 @@ SPEED_NOTED = 0.01   # a 1X this far from the declared speed is said so in the a
 # (the true 1X over the true 2X; 21 of them 6 dB or more); a loose machine's sub-harmonic reads -2.9 to
 # +0.4 dB (synth.machine): below this, the two cannot be told apart by the lines
 HALF_OVER_1X_DB = 6.0
+# Between HALF_AMBIGUOUS_DB under the 1X and HALF_OVER_1X_DB over it, a 0.5X line (1.5X standing too) is
+# either a loose machine's sub-harmonic or the true 1X of a record read at half its rate (or at a speed
+# declared twice too high): the answer stands, flagged ``half_order_ambiguous`` with that advice. The
+# development records at their own rate read 10 dB or more under it; CWRU B007_1 at half its rate -0.4 dB
+HALF_AMBIGUOUS_DB = -6.0
 # A 1X candidate more than SPEED_NOTED from the declared speed confirms the speed it shows only with at
 # least ONE_X_CONFIRMS of its harmonics 2X-6X; with fewer, neither it nor the declared speed is confirmed
 # and the bearing's own lines are searched at other speeds, as when no 1X is found. Reason: MFPT's
@@ -72,6 +77,13 @@ def _speed(job: Job, f, A):
                 f"{job.fs:g} Hz ({r * job.fs:g} Hz): check the sampling rate"))
             job.flags.append("speed_inconsistent")
             break
+        if (r == 2 and all(hits) and snr1 >= LINE_DB and lines[0][2] >= snr1 + HALF_AMBIGUOUS_DB
+                and "half_order_ambiguous" not in job.flags):
+            job.flags.append("half_order_ambiguous")
+            speed["note"] = " ".join(x for x in (speed["note"], (
+                f"the 0.5X and 1.5X lines stand within {-HALF_AMBIGUOUS_DB:g} dB of the 1X ({lines[0][2]:.1f} against "
+                f"{snr1:.1f} dB): a loose machine's sub-harmonics, or the true 1X of a record whose fs is 2x the "
+                f"declared {job.fs:g} Hz (or whose speed is half the declared {job.rpm:g} rpm): check both")) if x)
     if speed["consistent"] and not found:
         speed["note"] = f"no 1X line within {100 * SPEED_SEARCH:g} % of the declared {job.rpm:g} rpm"
     other = _contradiction(job, f, A, found, snr1) if speed["consistent"] else None
