@@ -468,8 +468,10 @@ def test_cli_batch_fails_when_every_input_failed_and_ctrl_c_is_one_line(tmp_path
     assert json.loads(out.getvalue())["counts"] == {"error": 1}
     folder = tmp_path / "many"
     folder.mkdir()
+    # long enough that Ctrl-C two seconds in finds it running: 40 records of 8 s took 3.9 s in all, and
+    # the signal then sometimes came as the batch ended
     for i in range(40):
-        vm.write(folder / f"r{i:02d}.h5", vm.synth.machine(rpm=1500.0, fs=12800.0, duration=8.0, seed=i))
+        vm.write(folder / f"r{i:02d}.h5", vm.synth.machine(rpm=1500.0, fs=12800.0, duration=30.0, seed=i))
     proc = subprocess.Popen([sys.executable, "-m", "vibmeasure", "batch", str(folder), "--store",
                              str(tmp_path / "big.db"), "--task", "diagnose"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
