@@ -50,9 +50,10 @@ def _limits(base, direction, kind, fw, fa):
     return mu, sd, max(K_WATCH * sd, fw - mu), max(K_ALARM * sd, fa - mu)
 
 
-def _level(v, mu, dw, da, direction):
-    dev = (v - mu) if direction > 0 else (mu - v) if direction < 0 else abs(v - mu)
-    return 2 if dev >= da else 1 if dev >= dw else 0
+def _levels(v: np.ndarray, mu, dw, da, direction) -> list:
+    """0 (within the watch limit), 1 (watch) or 2 (alarm) for each value (a NaN deviation is 0)."""
+    dev = (v - mu) if direction > 0 else (mu - v) if direction < 0 else np.abs(v - mu)
+    return np.where(dev >= da, 2, np.where(dev >= dw, 1, 0)).tolist()
 
 
 def trend(store, *, asset: str | None = None, point: str | None = None, baseline_count: int = 8,
@@ -241,14 +242,14 @@ def _relative(a, p, task, col, g, rule, baseline_count, horizon_days) -> dict:
     t = (g["time"] - g["time"].iloc[0]).dt.total_seconds().to_numpy() / 86400.0
     base = y[:baseline_count]
     mu, sd, dw, da = _limits(base, direction, kind, fw, fa)
-    lv = [_level(v, mu, dw, da, direction) for v in y[baseline_count:]]
+    lv = _levels(y[baseline_count:], mu, dw, da, direction)
     level = min(lv[-2:]) if len(lv) >= 2 else min(lv[-1], 1)
     # when each level was first reached (two measurements in a row): the alarm history
-    held = [min(lv[j - 1], lv[j]) for j in range(1, len(lv))]
+    held = np.minimum(lv[:-1], lv[1:])
     first = {}
     for lvl in (1, 2):
-        j = next((j for j, h in enumerate(held) if h >= lvl), None)
-        first[lvl] = None if j is None else g["time"].iloc[baseline_count + j + 1]
+        j = np.flatnonzero(held >= lvl)
+        first[lvl] = None if not j.size else g["time"].iloc[baseline_count + int(j[0]) + 1]
     from ..core.labels import label
     from ..core.rounding import with_std
     base, spread = with_std(mu, sd, digits=4)
