@@ -1104,19 +1104,23 @@ def test_gear_sidebands_without_an_impulsive_residual_are_held():
         assert fault.top == "gear_mesh" and fault.faults.set_index("fault").loc["gear_mesh"].fm4 > 6
 
 
+def _at_half_and_own_rate(path):
+    """A CWRU fan-end record's diagnosis read at half its 12 kHz rate, and at its own."""
+    rec = vm.read(path, fs=12000, unit="g")
+    fe = next(n for n in rec.names if n.endswith("_FE_time"))
+    half = vm.Record.from_array(rec.data, fs=rec.fs / 2, names=list(rec.names), unit="g")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        return tuple(vm.diagnose(r, rpm=rec.meta["rpm"], bearing="6203-2RS", channel=fe) for r in (half, rec))
+
+
 def test_a_record_read_at_half_its_rate_is_noticed_by_its_half_order_line(shared_data):
     """At half its true sampling rate every line reads at half its frequency: the true 2X stands where the
     1X is looked for and confirms the declared speed, the true 1X reads 0.5X. CWRU fan-end OR007@3_3
     (outer race) so read was answered undetermined at 0.99 with no flag. A 0.5X line 6 dB or more over the
     1X (with 1.5X standing) flags speed_inconsistent and holds the answer; at its own rate, and on a loose
     machine (whose sub-harmonic reads about as high as its 1X), nothing of the kind."""
-    rec = vm.read(shared_data("cwru_fe/OR007@3_3.mat"), fs=12000, unit="g")
-    fe = next(n for n in rec.names if n.endswith("_FE_time"))
-    half = vm.Record.from_array(rec.data, fs=rec.fs / 2, names=list(rec.names), unit="g")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", vm.QualityWarning)
-        d = vm.diagnose(half, rpm=rec.meta["rpm"], bearing="6203-2RS", channel=fe)
-        right = vm.diagnose(rec, rpm=rec.meta["rpm"], bearing="6203-2RS", channel=fe)
+    d, right = _at_half_and_own_rate(shared_data("cwru_fe/OR007@3_3.mat"))
     assert "speed_inconsistent" in d.flags and d.confidence <= 0.45 and "fs is 2x" in d.reason
     assert "speed_inconsistent" not in right.flags and right.top == "bearing_outer_race"
     loose = vm.diagnose(vm.synth.machine(fault="looseness", seed=1, duration=4.0), rpm=1797, bearing="6205-2RS")
@@ -1128,13 +1132,7 @@ def test_a_half_order_as_high_as_the_1x_is_said_to_be_ambiguous(shared_data):
     "1X" (the true 2X), as a loose machine's sub-harmonic does; the answer, undetermined, carried no flag.
     Within 6 dB of the 1X the half-order is flagged half_order_ambiguous with advice (check fs and the
     speed) and the answer stands; at its own rate (0.5X 10 dB or more under the 1X) no such flag."""
-    rec = vm.read(shared_data("cwru_fe/B007_1.mat"), fs=12000, unit="g")
-    fe = next(n for n in rec.names if n.endswith("_FE_time"))
-    half = vm.Record.from_array(rec.data, fs=rec.fs / 2, names=list(rec.names), unit="g")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", vm.QualityWarning)
-        d = vm.diagnose(half, rpm=rec.meta["rpm"], bearing="6203-2RS", channel=fe)
-        own = vm.diagnose(rec, rpm=rec.meta["rpm"], bearing="6203-2RS", channel=fe)
+    d, own = _at_half_and_own_rate(shared_data("cwru_fe/B007_1.mat"))
     assert "half_order_ambiguous" in d.flags and "speed_inconsistent" not in d.flags
     assert "fs is 2x the declared 6000 Hz" in d.reason and "check both" in d.reason
     assert "half_order_ambiguous" not in own.flags and own.top == "bearing_ball"
