@@ -112,3 +112,20 @@ def test_a_lone_tone_in_the_stop_band_does_not_reopen_it():
     clean = measured_top(np.fft.rfft(x), fs, x.size)
     spur = x + 0.05 * np.sin(2 * np.pi * 5000.0 * t)
     assert measured_top(np.fft.rfft(spur), fs, x.size) == pytest.approx(clean, abs=30.0)
+
+
+def test_the_tapered_spectrum_is_taken_once_per_content():
+    """The transient check and the bearing spectra share a channel's tapered spectrum: the same samples
+    (another array holding them too) give the same read-only spectrum, equal to the rfft it stands for;
+    samples changed in place give a new one, never the old."""
+    from scipy import fft as sfft
+    from scipy.signal.windows import tukey
+    from vibmeasure.signal.whiten import tapered_spectrum
+    x = np.random.default_rng(3).normal(size=4096)
+    X = tapered_spectrum(x, 0.05)
+    assert np.array_equal(X, sfft.rfft((x - x.mean()) * tukey(x.size, 0.05))) and not X.flags.writeable
+    assert tapered_spectrum(x.copy(), 0.05) is X
+    x[100] += 1.0
+    Y = tapered_spectrum(x, 0.05)
+    assert Y is not X and np.array_equal(Y, sfft.rfft((x - x.mean()) * tukey(x.size, 0.05)))
+    assert tapered_spectrum(x, 0.1) is not Y   # another taper, another spectrum

@@ -9,6 +9,7 @@ import numpy as np
 from scipy import fft as _sfft
 
 from ...signal.spectral import symmetric_window
+from ...signal.whiten import CACHED_SAMPLES
 
 if TYPE_CHECKING:   # for annotations only
     from .job import Job
@@ -45,7 +46,8 @@ def _spectrum(job: Job, window="hann"):
     V = np.where(f > 0, A / (2 * np.pi * np.maximum(f, 1e-12)), 0.0)  # velocity amplitude
     for arr in (f, A, V):
         arr.flags.writeable = False
-    _LAST["spectrum"] = (job.a, (job.fs, window), (f, A, V))
+    if n <= CACHED_SAMPLES:   # a long record's spectrum is not held after the analysis
+        _LAST["spectrum"] = (job.a, (job.fs, window), (f, A, V))
     return f, A, V
 
 
