@@ -77,9 +77,11 @@ def test_every_public_docstring_is_numpydoc():
 
 
 @pytest.mark.parametrize("name", sorted(public_objects()))
-def test_the_examples_run(name, monkeypatch):
+def test_the_examples_run(name, monkeypatch, tmp_path):
     obj = public_objects()[name]
     monkeypatch.chdir(ROOT)
+    import tempfile
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))   # the examples' scratch files go with the test
     import matplotlib
     matplotlib.use("Agg")
     finder = doctest.DocTestFinder(recurse=False)
