@@ -37,7 +37,7 @@ def _fill(st, n=3, raw=True):
 def test_results_of_several_tasks_from_one_query_are_each_tasks_own_frame(target, tmp_path):
     """What a trend reads in one query (every trended task at once) is, task by task, exactly the frame
     ``results`` gives for that task alone: its own summary columns, its latest result per measurement,
-    an error a later success replaced left out on the database store as before."""
+    and on every store only the errors no later success replaced (``results("error")`` is ``errors()``)."""
     url, raw_dir = target
     for store_target in (tmp_path / "ref.h5", url):
         with vm.Store(store_target, writable=True, **({"raw_dir": raw_dir} if store_target == url else {})) as st:
@@ -46,6 +46,7 @@ def test_results_of_several_tasks_from_one_query_are_each_tasks_own_frame(target
             st.add_result(ids[1], "error", {"task": "spectrum", "message": "x"}, summary={"failed_task": "spectrum"})
             st.add_result(ids[1], "spectrum", {"rms": 3.0}, summary={"rms": 3.0})
             st.add_result(ids[2], "diagnose", {"top": "looseness"}, summary={"top": "looseness", "confidence": 0.9})
+            st.add_result(ids[2], "error", {"task": "ringdown", "message": "y"}, summary={"failed_task": "ringdown"})
         st = vm.Store(store_target, **({"raw_dir": raw_dir} if store_target == url else {}))
         tasks = ["diagnosis", "spectrum", "error", "ringdown"]
         for lean in (True, False):
@@ -56,6 +57,8 @@ def test_results_of_several_tasks_from_one_query_are_each_tasks_own_frame(target
         assert frames["diagnose"]["top"].tolist() == ["none", "none", "looseness"]
         assert frames["spectrum"]["rms"].tolist() == [2.0, 3.0] and "top" not in frames["spectrum"]
         assert frames["ringdown"].empty
+        # ids[1]'s error was replaced by its spectrum; ids[2]'s came after its last success and stands
+        assert frames["error"]["measurement"].tolist() == [ids[2]] == st.errors()["measurement"].tolist()
 
 
 @pytest.fixture(params=["sqlite", "postgresql"])

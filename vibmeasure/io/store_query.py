@@ -194,9 +194,10 @@ class _Queries:
         check_flag(with_result, "with_result")
         task = TASK_ALIASES.get(task, task)
         meas = {r["id"]: (r["asset"], r["point"], r["time"]) for r in self._each("measurements")}
-        flat = []
-        for r in self._each("results"):
+        flat, at, last_ok = [], [], {}
+        for i, r in enumerate(self._each("results")):
             if r["task"] != task:
+                last_ok[r["measurement"]] = i
                 continue
             a, p, t = meas.get(r["measurement"], (None, None, None))
             if asset is not None and a != asset or point is not None and p != point:
@@ -204,6 +205,9 @@ class _Queries:
             flat.append({"measurement": r["measurement"], "asset": a, "point": p, "time": t, "task": r["task"],
                          "version": r["version"], "params": r.get("params", {}), **r.get("summary", {}),
                          **({"result": r.get("result")} if with_result else {})})
+            at.append(i)
+        if task == "error":   # an error a later analysis of the same measurement succeeded past is gone
+            flat = [row for row, i in zip(flat, at) if i > last_ok.get(row["measurement"], -1)]
         df = pd.DataFrame(flat)
         if df.empty:
             return pd.DataFrame(columns=["measurement", "asset", "point", "time", "task", "version", "params"])
@@ -275,15 +279,7 @@ class _Queries:
         >>> len(st.errors())
         0
         """
-        df = self.results("error")
-        if df.empty:
-            return df
-        # an error a later analysis of the same measurement succeeded past is no longer an error
-        last_error, last_ok = {}, {}
-        for i, r in enumerate(self._each("results")):
-            (last_error if r["task"] == "error" else last_ok)[r["measurement"]] = i
-        keep = [last_error[m] > last_ok.get(m, -1) for m in df["measurement"]]
-        return df[keep].reset_index(drop=True)
+        return self.results("error")
 
     @staticmethod
     def _timed(df, since, until):
