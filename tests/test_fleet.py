@@ -232,8 +232,12 @@ def test_batch_skips_what_is_stored_and_lists_bad_files(tmp_path):
     (tmp_path / "in" / "broken.h5").write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
     with open(man, "a") as fh:
         fh.write("broken.h5,m9,DE,1500,6205-2RS,2026-02-02T00:00:00\n")
-    rep = vm.batch(task="spectrum+diagnose", store=tmp_path / "s.h5", manifest=man)
+    calls = []
+    rep = vm.batch(task="spectrum+diagnose", store=tmp_path / "s.h5", manifest=man,
+                   progress=lambda done, total: calls.append((done, total)))
     assert list(rep["status"]).count("done") == 6 and list(rep["status"]).count("error") == 1
+    # the total is said before the first input is analysed (a Ctrl-C then reads "0 of 7 stored")
+    assert calls == [(k, 7) for k in range(8)]
     assert "broken.h5" in rep.loc[rep["status"] == "error", "file"].iloc[0]
     errs = vm.Store(tmp_path / "s.h5").errors()
     assert len(errs) == 1 and errs["failed_task"][0] == "read"

@@ -281,7 +281,7 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
     band : tuple of float, optional
         (lo, hi) Hz for the modes task.
     progress : callable, optional
-        ``progress(done, total)`` as inputs finish.
+        ``progress(done, total)``: once with 0 when the inputs to analyse are known, then as each finishes.
 
     Returns
     -------
@@ -338,6 +338,8 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
         total = len(todo)
         done = committed = 0
         last_commit = _time.monotonic()
+        if progress is not None:   # the bar, and what a Ctrl-C during the first input says, know the total
+            progress(0, total)
 
         touched: set = set()
 
