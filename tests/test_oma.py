@@ -330,6 +330,27 @@ def test_fdd_keeps_the_guides_chain_modes_with_a_stable_jackknife():
         assert all(fl == () or "close_modes" not in fl and "not_confirmed" not in fl for fl in both.mode_flags)
 
 
+def test_a_jackknife_replicate_is_the_full_fits_point_estimate():
+    """EFDD's replicates skip the ring-down's stds and classification (replicate_decay), not its fit:
+    a decay with an offset and a weaker second component, started from the poles of another noise
+    realisation's fit (about a std away, as a replicate starts from the full data's), gets the fn and
+    zeta linear_decay gets from the same start, to round-off (the same preparation, trim and
+    Levenberg-Marquardt rule: two steps alone leave zeta 1e-5 off here); a decay that grows is no
+    replicate (None)."""
+    from vibmeasure.identify._rd_linear import linear_decay, replicate_decay
+    fs = 200.0
+    t = np.arange(3000) / fs
+    x = (np.exp(-0.015 * 2 * np.pi * 7.0 * t) * np.cos(2 * np.pi * 7.0 * t + 0.3)
+         + 0.2 * np.exp(-0.02 * 2 * np.pi * 19.0 * t) * np.sin(2 * np.pi * 19.0 * t) + 0.01)
+    noisy = [vm.Record.from_array(x + 0.05 * np.random.default_rng(s).normal(size=t.size), fs=fs) for s in range(4)]
+    poles = linear_decay(noisy[0], 1).extras["fitted_poles"]
+    for rep in noisy[1:]:
+        ref = linear_decay(rep, 1, poles=poles)
+        assert replicate_decay(rep, poles, 7.0) == pytest.approx((ref.fn[0], ref.zeta[0]), rel=1e-12)
+    grow = vm.Record.from_array(np.exp(0.05 * t) * np.cos(2 * np.pi * 7.0 * t), fs=fs)
+    assert replicate_decay(grow, [complex(0.05, 2 * np.pi * 7.0)], 7.0) is None
+
+
 def test_fdd_refuses_an_nperseg_too_long_to_average():
     rec = _close_pair_tower(1)
     with pytest.raises(vm.ParameterError, match="at least 7 segments"):

@@ -108,21 +108,6 @@ def _numerical_failure(exc) -> FitError:
                     "give band= or start=, or cut the record")
 
 
-@single_threaded
-def linear_decay(rec, n_modes=1, poles=None) -> ModalEstimate:
-    """The ring-down estimator without its nonlinear checks (dry friction, amplitude-dependent damping,
-    backbone), for a decay that is linear by construction: EFDD's correlation function of a bell is an
-    average over amplitudes, where those checks have no meaning, and it is fitted a dozen times per
-    mode (bias steps, jackknife). The same fit, stds and mode flags as ``ringdown(rec, start=0)``;
-    ``extras["fitted_poles"]`` holds every fitted component's pole. ``poles`` (such a list from a fit
-    of a nearby decay, as a jackknife replicate's full-data fit) replaces the subspace and spectral
-    start values."""
-    try:
-        return _ringdown(rec, None, n_modes, None, 0.0, 8, None, None, linear=True, poles=poles)
-    except np.linalg.LinAlgError as exc:   # a fit gone to NaN or singular: said as the fit's failure
-        raise _numerical_failure(exc) from None
-
-
 def _ringdown(rec, channel, n_modes, band, start, max_modes, fs, progress, linear=False,
               poles=None) -> ModalEstimate:
     """The ring-down pipeline, one line per step (``linear``: the nonlinear checks left out)."""

@@ -215,13 +215,19 @@ def _remaining(step, previous):
     return rho / (1 - rho) * abs(step) if rho < 1 else np.inf
 
 
+def _correlation(bell, w, nperseg):
+    """The bell's correlation function (lags 0..nperseg-1) with the window's own correlation divided
+    out, and the window's correlation."""
+    r = np.fft.irfft(bell)[:nperseg]
+    wac = _window_autocorrelation(np.ascontiguousarray(w, float).tobytes())
+    return r / np.maximum(wac, 1e-12), wac
+
+
 def _efdd_fit(bell, w, fs, nperseg, end=None, poles=None):
     """Fit the bell's correlation function (a free decay) with the ring-down estimator, over ``end``
     samples (default: until its envelope falls to a tenth, or the window's own correlation to 0.3)."""
-    from ..ringdown import linear_decay
-    r = np.fft.irfft(bell)[:nperseg]
-    wac = _window_autocorrelation(np.ascontiguousarray(w, float).tobytes())
-    r = r / np.maximum(wac, 1e-12)
+    from .._rd_linear import linear_decay
+    r, wac = _correlation(bell, w, nperseg)
     r0 = r[0]
     if end is None:
         env = np.abs(_analytic(r[: nperseg // 2]))
@@ -333,13 +339,15 @@ def oma_fdd(rec, *, band=None, nperseg: int | None = None, channels=None, n_mode
     return _fdd_estimate(rec, names, f, S, U, picked, rejected, w, nper, mac_bell, band, n_seg, Gg)
 
 
-def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end, poles):
+def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end, poles, mode_hz):
     """Leave-one-group-out EFDD of one mode (the segments in N_GROUPS groups): jackknife std of fn
     and zeta of the plain fit, or None when fewer than all but one replicate succeed. (The bell-cut
     bias correction shifts every replicate alike; the caller scales the std by its slope.) Every
-    replicate fits the decay over the full data's ``end`` samples: the jackknife needs an estimator
-    that moves smoothly with the data, and a decay length chosen again per replicate jumps (one
-    replicate of eight cut at 261 samples instead of 420 tripled a std)."""
+    replicate fits the decay over the full data's ``end`` samples, from the full data's ``poles``, by
+    the ring-down fit without the stds it never reads (``_rd_linear.replicate_decay``): the jackknife
+    needs an estimator that moves smoothly with the data, and a decay length chosen again per
+    replicate jumps (one replicate of eight cut at 261 samples instead of 420 tripled a std)."""
+    from .._rd_linear import replicate_decay
     lo, hi = max(lines[0] - 5, 0), min(lines[-1] + 6, Gg.shape[1])
     tot = Gg[:, lo:hi].sum(axis=0)
     ref = U[c["line"], :, c["sv"]]
@@ -351,12 +359,12 @@ def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end, poles):
         sub, sub_lines = _bell(Sr, Ur, dict(c, line=c["line"] - lo, sv=k), mac_bell)
         bell = np.zeros(Gg.shape[1])
         bell[lo:hi] = sub
-        try:
-            e, _ = _efdd_fit(bell, w, fs, nper, end, poles)
-            if np.isfinite(e.fn[0]) and np.isfinite(e.zeta[0]):
-                vals.append((e.fn[0], e.zeta[0]))
-        except (FitError, ParameterError):
+        r, _ = _correlation(bell, w, nper)
+        if not (np.isfinite(r[0]) and r[0] > 0):
             continue
+        got = replicate_decay(Record.from_array(r[:end] / r[0], fs=fs, name="correlation"), poles, mode_hz)
+        if got is not None:
+            vals.append(got)
     n = Gg.shape[0]
     if len(vals) < n - 1:
         return None
@@ -371,7 +379,8 @@ def _efdd_mode(c, bell, lines, U, Gg, w, fs, nper, mac_bell, power):
     fl, bias = [], None
     try:
         e, end, bias = _efdd(bell, w, fs, nper, power)
-        jk = (_efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end, e.extras["fitted_poles"])
+        plain_hz = float(e.fn[0]) + (bias[0] if bias is not None else 0.0)   # the fit before the bias step
+        jk = (_efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end, e.extras["fitted_poles"], plain_hz)
               if Gg is not None else None)
         if bias is None:
             fl.append("bias_uncorrected")
