@@ -187,12 +187,11 @@ def _efdd(bell, w, fs, nperseg, power=0):
         # the (fn, zeta) whose exact bell, cut and fitted the same way, gives what the data gave
         exact = np.zeros(bell.size)
         exact[k] = fk ** power / ((fn ** 2 - fk ** 2) ** 2 + (2 * z * fn * fk) ** 2)
-        try:
-            wn = 2 * np.pi * fn
-            sim, _ = _efdd_fit(exact, w, fs, nperseg, poles=[complex(-z * wn, wn * np.sqrt(1 - z * z))])
-        except (FitError, ParameterError):
+        wn = 2 * np.pi * fn
+        sim, _ = _efdd_fit(exact, w, fs, nperseg, poles=[complex(-z * wn, wn * np.sqrt(1 - z * z))], mode_hz=fn)
+        if sim is None:
             return est, end, None   # the exact bell's decay cannot be fitted: keep the fit, flagged
-        step_f, step_z = fn0 - float(sim.fn[0]), z0 - float(sim.zeta[0])
+        step_f, step_z = fn0 - sim[0], z0 - sim[1]
         fn, z = fn + step_f, z + step_z
         if not (z > 0 and abs(z - z0) <= 0.5 * z0):
             return est, end, None   # not a small correction: keep the fit, the caller flags it
@@ -223,10 +222,13 @@ def _correlation(bell, w, nperseg):
     return r / np.maximum(wac, 1e-12), wac
 
 
-def _efdd_fit(bell, w, fs, nperseg, end=None, poles=None):
+def _efdd_fit(bell, w, fs, nperseg, end=None, poles=None, mode_hz=None):
     """Fit the bell's correlation function (a free decay) with the ring-down estimator, over ``end``
-    samples (default: until its envelope falls to a tenth, or the window's own correlation to 0.3)."""
-    from .._rd_linear import linear_decay
+    samples (default: until its envelope falls to a tenth, or the window's own correlation to 0.3).
+    With ``mode_hz`` (a jackknife replicate, the exact bell of a bias step) only the point estimate of
+    the mode nearest it is taken, (fn, zeta) or None: the same fit without the stds
+    (``_rd_linear.replicate_decay``)."""
+    from .._rd_linear import linear_decay, replicate_decay
     r, wac = _correlation(bell, w, nperseg)
     r0 = r[0]
     if end is None:
@@ -234,12 +236,17 @@ def _efdd_fit(bell, w, fs, nperseg, end=None, poles=None):
         low = np.flatnonzero(env[4:] < 0.1 * r0)
         end = int(low[0]) + 4 if low.size else nperseg // 2
         end = max(min(end, int(np.argmax(wac < 0.3)) or nperseg // 2), 64)
+    corr = Record.from_array(r[:end] / r0, fs=fs, name="correlation") if np.isfinite(r0) and r0 > 0 else None
+    if mode_hz is not None:
+        return (None if corr is None else replicate_decay(corr, poles, mode_hz)), end
+    if corr is None:
+        raise FitError("the bell holds no power: its correlation function is zero at lag 0")
     import warnings
 
     from ...core.errors import QualityWarning
     with warnings.catch_warnings():   # the ring-down's own findings stay in its flags, read by the caller
         warnings.simplefilter("ignore", QualityWarning)
-        est = linear_decay(Record.from_array(r[:end] / r0, fs=fs, name="correlation"), n_modes=1, poles=poles)
+        est = linear_decay(corr, n_modes=1, poles=poles)
     return est, end
 
 
@@ -347,7 +354,6 @@ def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end, poles, mode_hz)
     the ring-down fit without the stds it never reads (``_rd_linear.replicate_decay``): the jackknife
     needs an estimator that moves smoothly with the data, and a decay length chosen again per
     replicate jumps (one replicate of eight cut at 261 samples instead of 420 tripled a std)."""
-    from .._rd_linear import replicate_decay
     lo, hi = max(lines[0] - 5, 0), min(lines[-1] + 6, Gg.shape[1])
     tot = Gg[:, lo:hi].sum(axis=0)
     ref = U[c["line"], :, c["sv"]]
@@ -359,10 +365,7 @@ def _efdd_jackknife(Gg, c, lines, U, mac_bell, w, fs, nper, end, poles, mode_hz)
         sub, sub_lines = _bell(Sr, Ur, dict(c, line=c["line"] - lo, sv=k), mac_bell)
         bell = np.zeros(Gg.shape[1])
         bell[lo:hi] = sub
-        r, _ = _correlation(bell, w, nper)
-        if not (np.isfinite(r[0]) and r[0] > 0):
-            continue
-        got = replicate_decay(Record.from_array(r[:end] / r[0], fs=fs, name="correlation"), poles, mode_hz)
+        got, _ = _efdd_fit(bell, w, fs, nper, end, poles, mode_hz)
         if got is not None:
             vals.append(got)
     n = Gg.shape[0]
