@@ -34,8 +34,8 @@ def replicate_decay(rec, poles, mode_hz: float) -> tuple[float, float] | None:
     """(fn, zeta) of the mode (the component whose damped frequency is nearest ``mode_hz``) of
     ``linear_decay(rec, 1, poles)``, for a jackknife replicate: the same preparation, start amplitudes,
     trim and Levenberg-Marquardt fit to the same convergence rule, without what a replicate's caller
-    never reads (stds, the coloured-noise scale, classification, the estimate object: 60 % of a short
-    decay's fit). None when the replicate cannot be fitted or its mode does not decay (a replicate the
+    never reads (stds, the coloured-noise scale, classification, the estimate object: a fifth of a
+    short decay's fit, 1.16 -> 0.90 ms per call on pyOMA2's example). None when the replicate cannot be fitted or its mode does not decay (a replicate the
     full estimator refuses as too uncertain is kept: its spread widens the jackknife std).
 
     Examples
