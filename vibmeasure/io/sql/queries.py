@@ -5,7 +5,7 @@ from __future__ import annotations
 from ...core.errors import ParameterError
 from ...core._validate import check_flag
 from .._store_common import ALARM_COLUMNS, TASK_ALIASES, _seconds
-from .schema import _RAW_KEY, _loads, _many, _mid, _mnum, _tables
+from .schema import _RAW_KEY, _loads, _many, _mid, _mnum, _tables, _wide
 
 
 class _SQLQueries:
@@ -127,28 +127,44 @@ class _SQLQueries:
         return self._results_by_task((task,), asset, point, since, until, with_result=with_result)[task]
 
     def _results_by_task(self, tasks, asset=None, point=None, since=None, until=None, *, with_result=True) -> dict:
-        """{task: its ``results`` frame} for several tasks from one query: a trend asks for every trended
-        task, and each query walks the asset's measurements whether the task has results or not."""
-        import sqlalchemy as sa
-        t = _tables()
-        r, m = t["results"], t["measurements"]
+        """{task: its ``results`` frame} for several tasks from one query (a trend asks for every trended
+        task): one walk of the asset's stretch of the index per task, one round trip."""
         tasks = list(dict.fromkeys(TASK_ALIASES.get(k, k) for k in tasks))
         check_flag(with_result, "with_result")
-        doc = r.c.result if with_result else sa.null()
-        stmt = (sa.select(r.c.measurement, m.c.asset, m.c.point, m.c.time, r.c.task, r.c.version, r.c.params,
-                          r.c.summary, doc, m.c.id).join(m, r.c.measurement == m.c.id)
-                .where(r.c.task.in_(tasks)))
-        if "error" in tasks:   # an error a later analysis of the same measurement succeeded past is gone
-            r2 = r.alias("later")
-            gone = sa.exists().where(r2.c.measurement == r.c.measurement, r2.c.task != "error", r2.c.id > r.c.id)
-            stmt = stmt.where(~gone if tasks == ["error"] else sa.or_(r.c.task != "error", ~gone))
-        stmt = self._where(stmt, m, asset, point, since, until).order_by(r.c.id)
-        rows = self._run(stmt).all()
+        rows = self._run(self._results_statement(tasks, asset, point, since, until, with_result)).all()
         self._end_read()
         by_task = {k: [] for k in tasks}
         for row in rows:
             by_task[row[4]].append(row)
         return {k: _results_frame(v, with_result) for k, v in by_task.items()}
+
+    def _results_statement(self, tasks, asset, point, since, until, with_result):
+        """The query of ``_results_by_task``: measurement, asset, point, time, task, version, params,
+        summary, result (or NULL) and the result's id, oldest first."""
+        import sqlalchemy as sa
+        t = _tables()
+        r, m = t["results"], t["measurements"]
+        # the asset, point and time of each result: its own columns, or its measurement's in a
+        # version-1 store opened for reading
+        at = m if self._joined else r
+        cols = [r.c.measurement, at.c.asset, at.c.point, at.c.time, r.c.task, r.c.version, r.c.params,
+                r.c.summary, (r.c.result if with_result else sa.null()).label("result"), r.c.id]
+
+        def part(*conditions):
+            stmt = sa.select(*cols).where(r.c.task.in_(tasks), *conditions)
+            if self._joined:
+                stmt = stmt.join(m, r.c.measurement == m.c.id)
+            if "error" in tasks:   # an error a later analysis of the same measurement succeeded past is gone
+                r2 = r.alias("later")
+                gone = sa.exists().where(r2.c.measurement == r.c.measurement, r2.c.task != "error", r2.c.id > r.c.id)
+                stmt = stmt.where(~gone if tasks == ["error"] else sa.or_(r.c.task != "error", ~gone))
+            return self._where(stmt, at, asset, point, since, until).order_by(None)
+
+        if self._conn.dialect.name == "postgresql" and not self._joined:
+            # each part from its own partial index: the rows that fit the covering one and the wide rest
+            q = sa.union_all(part(~_wide(r)), part(_wide(r))).subquery()
+            return sa.select(q).order_by(q.c.time, q.c.measurement, q.c.id)
+        return part().order_by(at.c.time, r.c.measurement, r.c.id)
 
     def alarms(self, asset: str | None = None, point: str | None = None):
         """The alarm history: every change of a trend verdict (``ok``, ``watch``, ``alarm``) per asset,
@@ -225,13 +241,15 @@ class _SQLQueries:
         self._end_read()
         return out
 
-    def _known(self, measurement) -> bool:
+    def _located(self, measurement) -> tuple | None:
+        """(asset, point, time) of a stored measurement, or None for an id the store does not hold."""
         import sqlalchemy as sa
         n = _mnum(measurement)
         if n is None:
-            return False
+            return None
         m = _tables()["measurements"]
-        return bool(self._rows(sa.select(m.c.id).where(m.c.id == n)))
+        rows = self._rows(sa.select(m.c.asset, m.c.point, m.c.time).where(m.c.id == n))
+        return (rows[0]["asset"], rows[0]["point"], rows[0]["time"]) if rows else None
 
     @property
     def n_measurements(self) -> int:

@@ -21,10 +21,10 @@ from pathlib import Path
 
 from ...core._validate import regular_input
 from ...core.errors import ParameterError
-from .._store_common import VERDICT_COLUMNS, STORE_SCHEMA, STORE_VERSION, StoreLockedError, _asset_row, _check_name, _seconds
+from .._store_common import VERDICT_COLUMNS, STORE_SCHEMA, StoreLockedError, _asset_row, _check_name, _seconds
 from . import schema as _schema_mod
 from .queries import _SQLQueries
-from .schema import _dumps, _insert, _mid, _mnum, _short, _tables, _url
+from .schema import SQL_STORE_VERSION, _dumps, _insert, _mid, _mnum, _short, _tables, _url
 
 
 def _number(v):
@@ -99,7 +99,8 @@ class SQLStore(_SQLQueries):
         # measurements it has seen exist (rows are never deleted), and its results not yet sent
         # (sent in one executemany before any read or commit)
         self._seen_points: set = set()
-        self._seen_ids: set = set()
+        self._seen_ids: dict = {}      # measurement id -> (asset, point, time), copied into its results
+        self._joined = False           # a version-1 store read as it is: results get their asset through the join
         self._results_out: list = []
         if self.is_sqlite and self.path.exists():
             regular_input(self.path, "store")
@@ -162,9 +163,12 @@ class SQLStore(_SQLQueries):
         if info.get("schema") != STORE_SCHEMA:
             raise ParameterError(f"store {self.target!r} is not a vibmeasure store (schema {info.get('schema')!r})")
         version = int(info.get("schema_version", "0"))
-        if version > STORE_VERSION:
+        if version > SQL_STORE_VERSION:
             raise ParameterError(f"store {self.target!r} has schema_version {version}; this vibmeasure reads up to "
-                                 f"{STORE_VERSION}")
+                                 f"{SQL_STORE_VERSION}")
+        if version < 2 and self.writable:
+            self._upgrade(sa)
+        self._joined = version < 2 and not self.writable
 
     def _create(self, sa):
         """The schema and its version row. Two writers creating one store at once: a CREATE may fail on a
@@ -184,10 +188,45 @@ class SQLStore(_SQLQueries):
                 _time.sleep(0.05)
         ins = _insert(self._conn, t["vibmeasure"])
         self._conn.execute(ins.values([{"key": "schema", "value": STORE_SCHEMA},
-                                       {"key": "schema_version", "value": str(STORE_VERSION)},
+                                       {"key": "schema_version", "value": str(SQL_STORE_VERSION)},
                                        {"key": "created", "value": repr(_time.time())}])
                            .on_conflict_do_nothing())
         self._conn.commit()
+
+    def _upgrade(self, sa):
+        """A version-1 store made version 2: the results' asset, point and time columns added and copied
+        from their measurements (one transaction), PostgreSQL's table vacuumed (so that the index-only
+        scans need not visit the rows the copy rewrote), then the indexes built and the version set (a
+        million results: about half a minute, once). Two writers upgrading at once: the second finds the
+        work done; a writer of an older vibmeasure still connected writes rows the trend does not see."""
+        t = _tables()
+        r, m, v = t["results"], t["measurements"], t["vibmeasure"]
+        deadline = _time.monotonic() + self.timeout + 60.0
+        while True:
+            try:
+                have = {c["name"] for c in sa.inspect(self._conn).get_columns("results")}
+                quote = self._conn.dialect.identifier_preparer.quote
+                for name in ("asset", "point", "time"):
+                    if name not in have:
+                        kind = r.c[name].type.compile(dialect=self._conn.dialect)
+                        self._conn.execute(sa.text(f"ALTER TABLE results ADD COLUMN {quote(name)} {kind}"))
+                of = {k: sa.select(m.c[k]).where(m.c.id == r.c.measurement).scalar_subquery()
+                      for k in ("asset", "point", "time")}
+                self._conn.execute(r.update().where(r.c.asset.is_(None)).values(**of))
+                self._conn.commit()
+                if self._conn.dialect.name == "postgresql":
+                    with self._engine.connect().execution_options(isolation_level="AUTOCOMMIT") as c:
+                        c.execute(sa.text("VACUUM ANALYZE results"))
+                for index in r.indexes:
+                    index.create(self._conn, checkfirst=True)
+                self._conn.execute(v.update().where(v.c.key == "schema_version").values(value=str(SQL_STORE_VERSION)))
+                self._conn.commit()
+                return
+            except (sa.exc.OperationalError, sa.exc.ProgrammingError, sa.exc.IntegrityError):
+                self._conn.rollback()
+                if _time.monotonic() > deadline:
+                    raise
+                _time.sleep(0.05)
 
     def _raise_operational(self, exc):
         text = _short(exc)
@@ -396,7 +435,7 @@ class SQLStore(_SQLQueries):
             raw=raw, meta=meta_text))
         self._n_pending += 1
         mid = _mid(res.inserted_primary_key[0])
-        self._seen_ids.add(mid)
+        self._seen_ids[mid] = (asset, point, t)
         return mid
 
     def _write_raw(self, record) -> str:
@@ -502,10 +541,12 @@ class SQLStore(_SQLQueries):
         from ... import __version__
         from ...core.results import jsonable
         self._need_writable()
-        if measurement not in self._seen_ids:
-            if not self._known(measurement):
+        where = self._seen_ids.get(measurement) if isinstance(measurement, str) else None
+        if where is None:
+            where = self._located(measurement)
+            if where is None:
                 raise ParameterError(f"measurement={measurement!r} is not in the store")
-            self._seen_ids.add(measurement)
+            self._seen_ids[measurement] = where
         task = _check_name(task, "task")
         try:
             cols = {k: _dumps(jsonable(v or {})) for k, v in (("params", params), ("summary", summary))}
@@ -513,5 +554,5 @@ class SQLStore(_SQLQueries):
         except (TypeError, ValueError) as exc:
             raise ParameterError(f"the {task!r} result is not JSON-able ({exc})") from None
         self._results_out.append(dict(measurement=_mnum(measurement), task=task, version=__version__,
-                                      created=_time.time(), **cols))
+                                      created=_time.time(), asset=where[0], point=where[1], time=where[2], **cols))
         self._n_pending += 1
