@@ -24,6 +24,7 @@ LABELS = {
     "undetermined": "undetermined",
     "velocity_rms_mm_s": "velocity RMS [mm/s]",
     "bearing_evidence": "bearing evidence [-log10 p]",
+    "gear_na4": "gear NA4",
     "rms": "RMS",
     "zone": "ISO zone",
     "top": "diagnosis",

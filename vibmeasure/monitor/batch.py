@@ -1,9 +1,9 @@
 """Batch analysis into a measurement store, serially or on a Dask cluster.
 
 Inputs are files, folders and globs, with an optional manifest (CSV: ``file`` (name or glob relative
-to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``model``, ``time``, ``unit`` and
-``fs`` (for files that do not state them), and for a speed that varies ``tach`` (the tachometer channel)
-and ``pulses_per_rev``). A manifest row's ``channel`` is the point's sensor: the only one analysed.
+to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``gear`` (teeth), ``model``,
+``time``, ``unit`` and ``fs`` (for files that do not state them), and for a speed that varies ``tach``
+(the tachometer channel) and ``pulses_per_rev``). A manifest row's ``channel`` is the point's sensor: the only one analysed.
 Each input is read and analysed by a pure function (:func:`analyse_file`) that returns plain data;
 with Dask the workers run it and only the client writes the store, committing every few dozen
 results. One bad file never stops the batch: its error is stored and listed. An input whose content
@@ -100,8 +100,9 @@ def _run(task, rec, item, options):
         if rpm is None and tach is None:
             raise ParameterError("task 'diagnose' needs the shaft speed: give rpm (or a tach channel) in the manifest, "
                                  "or a file that states it")
-        d = vm.diagnose(rec, rpm=None if rpm is None else float(rpm), bearing=item.get("bearing"), channel=ch,
-                        channels=channels, tach=tach, pulses_per_rev=item.get("pulses_per_rev") or 1)
+        d = vm.diagnose(rec, rpm=None if rpm is None else float(rpm), bearing=item.get("bearing"),
+                        gear=item.get("gear"), channel=ch, channels=channels, tach=tach,
+                        pulses_per_rev=item.get("pulses_per_rev") or 1)
         rpm = d.speed.get("estimated_rpm") if rpm is None else rpm
         sev = d.severity or {}
         summary = {"top": d.top, "confidence": float(d.confidence),
@@ -113,8 +114,24 @@ def _run(task, rec, item, options):
             lp = [float(v) for f, v in zip(fam["fault"], fam["log10_p"])
                   if str(f).startswith("bearing_") and f != "bearing_cage" and v == v and v is not None]
             summary["bearing_evidence"] = float(-min(lp)) if lp else 0.0
-        return d.to_dict(), summary, {"rpm": float(rpm), "bearing": item.get("bearing"), "channel": d.channel}
+        if fam is not None and "fm4" in getattr(fam, "columns", ()):
+            # the gear's synchronous residual: its FM4 and variance (the trend's NA4 needs both)
+            row = fam[fam["fault"] == "gear_mesh"]
+            if len(row):
+                summary["gear_fm4"] = _finite(row["fm4"].iloc[0])
+                summary["gear_residual_var"] = _finite(row["residual_var"].iloc[0])
+        params = {"rpm": float(rpm), "bearing": item.get("bearing"), "channel": d.channel}
+        return d.to_dict(), summary, (dict(params, gear=item["gear"]) if item.get("gear") else params)
     raise ParameterError(f"task {task!r} is not a per-file task")
+
+
+def _finite(v):
+    """A finite float, or None (a summary holds no NaN)."""
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return None
+    return v if np.isfinite(v) else None
 
 
 def analyse_files(items: list, tasks, options: dict | None = None) -> list:
@@ -172,7 +189,7 @@ def _register(store, item, channels):
     asset = _asset_of(item)
     point = item.get("point") or item.get("channel") or (channels[0] if channels else "point")
     if asset not in store._assets:
-        store.add_asset(asset, bearing=item.get("bearing"), model=item.get("model"))
+        store.add_asset(asset, bearing=item.get("bearing"), gear=item.get("gear"), model=item.get("model"))
     if (asset, point) not in store._points:
         store.add_point(asset, point, channel=item.get("channel"))
     return asset, point

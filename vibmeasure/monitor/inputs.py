@@ -14,7 +14,7 @@ from ..core.errors import ParameterError
 __all__ = ["read_manifest", "MANIFEST_COLUMNS"]
 
 MANIFEST_COLUMNS = ("file", "asset", "point", "channel", "rpm", "bearing", "model", "time", "tach", "pulses_per_rev",
-                    "unit", "fs")
+                    "unit", "fs", "gear")
 MAX_MANIFEST_BYTES = 256 << 20   # a manifest lists files: 256 MiB is millions of rows, more is not one
 READABLE = (".csv", ".txt", ".h5", ".hdf5", ".wav", ".mat", ".lvm", ".uff", ".unv")
 
@@ -26,7 +26,8 @@ def read_manifest(path) -> list[dict]:
     ----------
     path : str or os.PathLike
         The manifest: columns file, asset, point, channel, rpm, bearing, model, time, tach,
-        pulses_per_rev, unit, fs (any other column is an error).
+        pulses_per_rev, unit, fs, gear (the teeth of a gear on the measured shaft; any other column
+        is an error).
 
     Returns
     -------
@@ -99,13 +100,14 @@ def _manifest_row(raw: dict, p: Path) -> list[dict]:
                 raise ParameterError(f"{key}={row[key]!r} is not a number") from None
             if not (math.isfinite(row[key]) and row[key] > 0):
                 raise ParameterError(f"{key}={row[key]!r} must be a finite number > 0")
-    if row.get("pulses_per_rev"):
-        try:
-            row["pulses_per_rev"] = int(row["pulses_per_rev"])
-        except ValueError:
-            raise ParameterError(f"pulses_per_rev={row['pulses_per_rev']!r} is not a whole number") from None
-        if row["pulses_per_rev"] < 1:
-            raise ParameterError(f"pulses_per_rev={row['pulses_per_rev']} must be >= 1")
+    for key, least in (("pulses_per_rev", 1), ("gear", 2)):
+        if row.get(key):
+            try:
+                row[key] = int(row[key])
+            except ValueError:
+                raise ParameterError(f"{key}={row[key]!r} is not a whole number") from None
+            if row[key] < least:
+                raise ParameterError(f"{key}={row[key]} must be >= {least}")
     if row.get("time"):
         import pandas as pd
         try:

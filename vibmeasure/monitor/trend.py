@@ -16,6 +16,12 @@ is a watch or an alarm; a baseline taken while a fault was already there cannot 
 with fewer measurements than the baseline needs is listed ("no baseline yet") with what the absolute rules
 say, never left out. A measurement analysed again (``batch(force=True)``) counts once, by its
 latest result.
+
+NA4 (Zakrajsek 1993, in the form normalised by a healthy history): the gear's synchronous residual
+kurtosis with the current residual's fourth moment over the square of the baseline's mean variance,
+``gear_na4 = FM4 x (variance / baseline mean variance)^2``. FM4 stays near 3 as damage spreads over
+every tooth (the residual grows but stays Gaussian); NA4 keeps growing with the residual's level.
+Watch at 4/3 of the baseline's NA4 (FM4's fault threshold, 4, over a healthy 3), alarm at twice it.
 """
 
 from __future__ import annotations
@@ -24,7 +30,7 @@ import numpy as np
 
 from ..core.errors import ParameterError
 
-__all__ = ["trend", "metric_history", "METRICS"]
+__all__ = ["trend", "metric_history", "with_na4", "METRICS"]
 
 K_WATCH, K_ALARM = 3.0, 6.0
 LEVELS = ("ok", "watch", "alarm")
@@ -34,11 +40,13 @@ NAMED = 0.5             # a diagnosis naming a fault from this confidence on cou
 METRICS = (
     ("diagnose", "velocity_rms_mm_s", +1, "relative", 0.5, 1.0),
     ("diagnose", "bearing_evidence", +1, "absolute", 8.0, 12.0),
+    ("diagnose", "gear_na4", +1, "relative", 1 / 3, 1.0),
     ("spectrum", "rms", +1, "relative", 0.5, 1.0),
     ("ringdown", "fn1_hz", 0, "relative", 0.005, 0.01),
     ("modes", "fn1_hz", 0, "relative", 0.005, 0.01),
 )
 ISO_VERDICT = {"A": 0, "B": 0, "C": 1, "D": 2}
+SOURCE = {"gear_na4": "gear_fm4"}   # a derived metric's stored column: the measurements that count toward it
 
 
 def _limits(base, direction, kind, fw, fa):
@@ -107,15 +115,19 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
     # one row per measurement: a measurement analysed again counts once, by its latest result
     # (the summary values only: the full result documents are most of a long history's query time)
     frames = st._results_by_task([t for t, *_ in METRICS], asset=asset, point=point, with_result=False)
+    frames["diagnose"] = with_na4(frames["diagnose"], baseline_count)
     rows += _diagnosis_rows(frames.get("diagnose"))
     for task, col, direction, kind, fw, fa in METRICS:
         df = frames[task]
         if df.empty or col not in df:
             continue
         for (a, p), g in df.groupby(["asset", "point"], sort=True):
-            g = g[np.isfinite(pd.to_numeric(g[col], errors="coerce"))]
+            have = g[np.isfinite(pd.to_numeric(g[SOURCE.get(col, col)], errors="coerce"))]
+            if have.empty:   # a metric the point never had (no unit, no gear): its diagnosis row lists it
+                continue
+            g = have[np.isfinite(pd.to_numeric(have[col], errors="coerce"))]
             if len(g) < baseline_count + 1:
-                rows.append(_too_few(a, p, task, col, g, baseline_count))
+                rows.append(_too_few(a, p, task, col, have, baseline_count))
                 continue
             rows.append(_relative(a, p, task, col, g, (direction, kind, fw, fa), baseline_count, horizon_days))
     out = pd.DataFrame(rows, columns=["asset", "point", "task", "metric", "n", "baseline_mean", "baseline_std",
@@ -129,6 +141,34 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
     out.attrs["points"] = {f"{a}/{p}": _verdict(v) for (a, p), v in dict(pts).items()}
     out.attrs["assets"] = {a: _verdict(v) for a, v in dict(ass).items()}
     return out.drop(columns="level")
+
+
+def with_na4(df, baseline_count: int):
+    """The diagnose results with ``gear_na4`` per point where they hold the gear's ``gear_fm4`` and
+    ``gear_residual_var``: FM4 x (variance / the mean variance of the point's first ``baseline_count``
+    measurements that have one)^2, NaN until that many exist. ``df`` is returned as it is without them.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from vibmeasure.monitor.trend import with_na4
+    >>> df = pd.DataFrame({"asset": "g", "point": "p", "gear_fm4": [3.0, 3.0, 3.0], "gear_residual_var": [1.0, 1.0, 2.0]})
+    >>> with_na4(df, 2)["gear_na4"].tolist()
+    [3.0, 3.0, 12.0]
+    """
+    if df is None or df.empty or "gear_fm4" not in df or "gear_residual_var" not in df:
+        return df
+    import pandas as pd
+    df = df.copy()
+    fm4 = pd.to_numeric(df["gear_fm4"], errors="coerce").to_numpy(float)
+    var = pd.to_numeric(df["gear_residual_var"], errors="coerce").to_numpy(float)
+    na4 = np.full(len(df), np.nan)
+    for idx in df.groupby(["asset", "point"], sort=False).indices.values():
+        ok = idx[np.isfinite(fm4[idx]) & np.isfinite(var[idx]) & (var[idx] > 0)]
+        if ok.size >= baseline_count:
+            na4[ok] = fm4[ok] * (var[ok] / np.mean(var[ok[:baseline_count]])) ** 2
+    df["gear_na4"] = na4
+    return df
 
 
 def _verdict(level) -> str:
@@ -195,7 +235,7 @@ def metric_history(store, *, asset: str, point: str, metric: str, task: str | No
     asset, point : str
         The asset and its measurement point.
     metric : str
-        A trended summary column (``METRICS``: velocity_rms_mm_s, bearing_evidence, rms, fn1_hz).
+        A trended summary column (``METRICS``: velocity_rms_mm_s, bearing_evidence, gear_na4, rms, fn1_hz).
     task : str, optional
         The task whose results hold the metric (default: the first that has it).
     baseline_count : int
@@ -223,7 +263,7 @@ def metric_history(store, *, asset: str, point: str, metric: str, task: str | No
     tasks = [t for t, c, *_ in METRICS if c == metric and (task is None or t == task)]
     if not tasks:
         raise ParameterError(f"metric={metric!r} is not trended; one of {sorted({c for _, c, *_ in METRICS})}")
-    found = (st.results(t, asset=asset, point=point, with_result=False) for t in tasks)
+    found = (with_na4(st.results(t, asset=asset, point=point, with_result=False), baseline_count) for t in tasks)
     df = next((d for d in found if not d.empty and metric in d), None)
     if df is None:
         raise ParameterError(f"no {metric} results for {asset}/{point} in the store")

@@ -28,12 +28,13 @@ FM4_FAULT = 4.0
 MIN_REVOLUTIONS = 10    # revolutions the synchronous average needs
 
 
-def difference_kurtosis(x: np.ndarray, fs: float, f_shaft: float, mesh_order: float) -> float | None:
-    """FM4 of x at the shaft speed f_shaft whose mesh is ``mesh_order`` x that speed: the samples
-    binned by shaft phase and averaged over every revolution (a time-synchronous average without a
-    tachometer, at the constant speed the analysis found), the regular orders taken out, the kurtosis
-    of what is left. None when the record holds too few revolutions or too few samples per revolution
-    for the mesh's third harmonic."""
+def residual_moments(x: np.ndarray, fs: float, f_shaft: float, mesh_order: float) -> tuple | None:
+    """(variance, FM4) of x's synchronous residual at the shaft speed f_shaft whose mesh is
+    ``mesh_order`` x that speed: the samples binned by shaft phase and averaged over every revolution
+    (a time-synchronous average without a tachometer, at the constant speed the analysis found), the
+    regular orders taken out; FM4 is the kurtosis of what is left, the variance (the signal's unit
+    squared) what NA4 normalises by over a healthy history (``vm.trend``). None when the record holds
+    too few revolutions or too few samples per revolution for the mesh's third harmonic."""
     per_rev = int(min(4096, 2 ** int(np.floor(np.log2(max(fs / f_shaft, 1.0))))))
     if per_rev < 2 * (3 * mesh_order + 3) or x.size * f_shaft / fs < MIN_REVOLUTIONS:
         return None
@@ -47,7 +48,7 @@ def difference_kurtosis(x: np.ndarray, fs: float, f_shaft: float, mesh_order: fl
     A[regular] = 0
     d = np.fft.irfft(A, per_rev)
     power = float(np.sum(d ** 2))
-    return float(per_rev * np.sum(d ** 4) / power ** 2) if power > 0 else None
+    return (power / per_rev, float(per_rev * np.sum(d ** 4) / power ** 2)) if power > 0 else None
 
 
 def _heights(A: np.ndarray, df: float, hz: np.ndarray, tol: int, ring: int) -> np.ndarray:
@@ -127,7 +128,7 @@ def gear_rows(run) -> list:
     # the average needs the shaft's speed to a small part of a turn over the record: the mesh line, many
     # orders up, measures it better than the 1X (0.1 % off smears a pulse over a fifth of a turn in 180)
     order = fm / spacing
-    fm4 = difference_kurtosis(run.job.a, run.job.fs, mesh_f / order, order)
+    var, fm4 = residual_moments(run.job.a, run.job.fs, mesh_f / order, order) or (None, None)
     note = (f"mesh {gear.teeth} x 1X at {mesh_db:.0f} dB; wide sidebands (+-2..6 x {name}'s {spacing:.2f} Hz) stand "
             f"in {c} of {places} places more than halfway between the mesh harmonics, decoy spacings p = {p:.2g}"
             + "".join(f"; {n}: {counts[n]}" for n, _ in shafts if n != name)
@@ -139,4 +140,5 @@ def gear_rows(run) -> list:
                  "tooth fault makes it: a distributed modulation (an eccentric or off-centre gear, load changes) "
                  "or a wandering speed")
         run.job.flags.append("gear_not_impulsive")
-    return [_row("gear_mesh", fm, mesh_f, mesh_amp, mesh_db, score, note, sidebands=c, decoy_p=p, fm4=fm4)]
+    return [_row("gear_mesh", fm, mesh_f, mesh_amp, mesh_db, score, note, sidebands=c, decoy_p=p, fm4=fm4,
+                 residual_var=var)]
