@@ -428,3 +428,24 @@ def test_postgresql_reads_a_trend_from_the_covering_index_and_keeps_wide_rows(po
         plan = "\n".join(r[0] for r in st._conn.exec_driver_sql("EXPLAIN " + str(compiled), compiled.params))
     assert "Index Only Scan using ix_results_asset_task_time" in plan, plan
     assert "ix_results_wide" in plan, plan
+
+
+def test_a_version_1_store_a_writer_may_not_alter_is_named_and_still_read(postgres, tmp_path):
+    """A plant's collector often writes under a role that may insert but not alter tables: opening a
+    version-1 store for writing then names the rule (ParameterError, no retry loop, no traceback from
+    the driver), and the store is still read as it is."""
+    import psycopg
+    url = postgres()
+    with vm.Store(url, writable=True, raw_dir=tmp_path / "raw") as st:
+        _fill(st, n=2, raw=False)
+    _as_version_1(url)
+    with psycopg.connect(url, autocommit=True) as c:
+        c.execute("CREATE ROLE collector LOGIN")
+        c.execute("GRANT SELECT, INSERT, UPDATE ON ALL TABLES IN SCHEMA public TO collector")
+    as_collector = url.replace("vibmeasure@", "collector@")
+    t0 = time.monotonic()
+    with pytest.raises(vm.ParameterError, match="schema_version 1 and could not be upgraded.*may alter"):
+        vm.Store(as_collector, writable=True, raw_dir=tmp_path / "raw")
+    assert time.monotonic() - t0 < 10.0
+    with vm.Store(as_collector, raw_dir=tmp_path / "raw") as st:
+        assert st.results("diagnose")["confidence"].tolist() == pytest.approx([0.5, 0.6])

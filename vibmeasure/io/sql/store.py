@@ -222,10 +222,15 @@ class SQLStore(_SQLQueries):
                 self._conn.execute(v.update().where(v.c.key == "schema_version").values(value=str(SQL_STORE_VERSION)))
                 self._conn.commit()
                 return
-            except (sa.exc.OperationalError, sa.exc.ProgrammingError, sa.exc.IntegrityError):
+            except (sa.exc.OperationalError, sa.exc.ProgrammingError, sa.exc.IntegrityError) as exc:
                 self._conn.rollback()
-                if _time.monotonic() > deadline:
-                    raise
+                text = _short(exc).lower()
+                # another writer's upgrade: its columns or indexes appear under ours, or it holds the lock
+                racing = any(w in text for w in ("already exists", "duplicate", "locked", "busy", "deadlock"))
+                if not racing or _time.monotonic() > deadline:
+                    raise ParameterError(f"store {self.target!r} has schema_version 1 and could not be upgraded to "
+                                         f"{SQL_STORE_VERSION} ({_short(exc)}): open it for writing once as a user "
+                                         "who may alter its tables, or open it read-only") from None
                 _time.sleep(0.05)
 
     def _raise_operational(self, exc):
