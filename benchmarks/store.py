@@ -8,9 +8,9 @@ with ``with_result=False`` (the summary values only: the query ``vm.trend`` make
 that asset. The HDF5 store copies and seals its whole file on every commit, so it is run only up to
 20,000 results; a database appends rows in a transaction. PostgreSQL is run when a URL of an empty
 database is given (the tests start a throw-away cluster the same way). Targets: commit cost flat
-(last / first <= 3), the year's query under 0.2 s. At 1,000,000 results the tables (330 MB) outgrow
-PostgreSQL's default shared_buffers (128 MB) and one asset's rows lie on every block: the query reads
-from the OS cache; a server with shared_buffers that hold the tables answers about a third faster.
+(last / first <= 3), the year's query under 0.2 s. One asset's rows lie one per table block (the plant
+writes every asset each hour): the results carry their asset and time, and on PostgreSQL a covering
+index answers the summary-only query without visiting the table (``docs/store.md``).
 
     python benchmarks/store.py [N_RESULTS] [--postgres postgresql://user@127.0.0.1:PORT/db] [--only h5|sqlite|postgres]
 """
