@@ -1,6 +1,7 @@
 """A gear's history in the fleet: the manifest's ``gear`` column reaches the diagnosis, its synchronous
 residual (FM4 and variance) is stored, and the trend's NA4 sees distributed wear that FM4 cannot."""
 
+import re
 import warnings
 
 import numpy as np
@@ -64,3 +65,22 @@ def test_distributed_wear_alarms_by_na4_where_fm4_stays_gaussian(tmp_path, wear)
         assert row["verdict"] == "ok" and row["last"] == pytest.approx(3.0, abs=0.3)
     else:
         assert row["verdict"] == "alarm" and row["last"] == pytest.approx(3.0 * wear ** 4, rel=0.15)
+
+
+def test_the_manifests_gear_is_teeth_or_teeth_and_the_mating_gears(tmp_path):
+    """``gear`` is the measured shaft's gear teeth (32) or with the mating gear's (32/71: the mating shaft
+    turns at 32/71 of this one's speed, whose sidebands the gear test weighs against this shaft's);
+    anything else is named as that row's error (the other rows are analysed)."""
+    from vibmeasure.monitor.batch import _gear
+    from vibmeasure.monitor.inputs import read_manifest
+    m = tmp_path / "m.csv"
+    m.write_text("file,asset,gear\na.h5,g,32\nb.h5,g,32/71\nc.h5,g,\n")
+    rows = read_manifest(m)
+    assert [r.get("gear") for r in rows][:2] == [32, "32/71"] and not rows[2].get("gear")
+    assert _gear(rows[0]["gear"]) == vm.Gear(32)
+    assert _gear(rows[1]["gear"]).mating_shaft_ratio == pytest.approx(32 / 71, rel=1e-15)
+    for bad in ("3", "32/4", "32.5", "32/71/9", "teeth"):
+        m.write_text(f"file,asset,gear\na.h5,g,{bad}\nb.h5,g,32\n")
+        first, second = read_manifest(m)
+        assert "row 2" in first["error"] and re.search(r"gear=.*teeth \(>= 5\)", first["error"]), first
+        assert second["gear"] == 32 and "error" not in second

@@ -1,7 +1,7 @@
 """Batch analysis into a measurement store, serially or on a Dask cluster.
 
 Inputs are files, folders and globs, with an optional manifest (CSV: ``file`` (name or glob relative
-to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``gear`` (teeth), ``model``,
+to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``gear`` (teeth, or teeth/mating teeth), ``model``,
 ``time``, ``unit`` and ``fs`` (for files that do not state them), and for a speed that varies ``tach``
 (the tachometer channel) and ``pulses_per_rev``). A manifest row's ``channel`` is the point's sensor: the only one analysed.
 Each input is read and analysed by a pure function (:func:`analyse_file`) that returns plain data;
@@ -101,7 +101,7 @@ def _run(task, rec, item, options):
             raise ParameterError("task 'diagnose' needs the shaft speed: give rpm (or a tach channel) in the manifest, "
                                  "or a file that states it")
         d = vm.diagnose(rec, rpm=None if rpm is None else float(rpm), bearing=item.get("bearing"),
-                        gear=item.get("gear"), channel=ch, channels=channels, tach=tach,
+                        gear=_gear(item.get("gear")), channel=ch, channels=channels, tach=tach,
                         pulses_per_rev=item.get("pulses_per_rev") or 1)
         rpm = d.speed.get("estimated_rpm") if rpm is None else rpm
         sev = d.severity or {}
@@ -123,6 +123,15 @@ def _run(task, rec, item, options):
         params = {"rpm": float(rpm), "bearing": item.get("bearing"), "channel": d.channel}
         return d.to_dict(), summary, (dict(params, gear=item["gear"]) if item.get("gear") else params)
     raise ParameterError(f"task {task!r} is not a per-file task")
+
+
+def _gear(spec):
+    """A manifest's gear (``inputs._gear_spec``: teeth, or "teeth/mating teeth") as a vm.Gear, or None."""
+    if spec is None or spec == "":
+        return None
+    from ..models.bearing import Gear
+    teeth = [int(p) for p in str(spec).split("/")]
+    return Gear(teeth[0], mating_shaft_ratio=teeth[0] / teeth[1] if len(teeth) == 2 else None)
 
 
 def _finite(v):

@@ -26,8 +26,8 @@ def read_manifest(path) -> list[dict]:
     ----------
     path : str or os.PathLike
         The manifest: columns file, asset, point, channel, rpm, bearing, model, time, tach,
-        pulses_per_rev, unit, fs, gear (the teeth of a gear on the measured shaft; any other column
-        is an error).
+        pulses_per_rev, unit, fs, gear (the teeth of a gear on the measured shaft, ``32``, or with
+        its mating gear's, ``32/71``; any other column is an error).
 
     Returns
     -------
@@ -100,14 +100,15 @@ def _manifest_row(raw: dict, p: Path) -> list[dict]:
                 raise ParameterError(f"{key}={row[key]!r} is not a number") from None
             if not (math.isfinite(row[key]) and row[key] > 0):
                 raise ParameterError(f"{key}={row[key]!r} must be a finite number > 0")
-    for key, least in (("pulses_per_rev", 1), ("gear", 2)):
-        if row.get(key):
-            try:
-                row[key] = int(row[key])
-            except ValueError:
-                raise ParameterError(f"{key}={row[key]!r} is not a whole number") from None
-            if row[key] < least:
-                raise ParameterError(f"{key}={row[key]} must be >= {least}")
+    if row.get("pulses_per_rev"):
+        try:
+            row["pulses_per_rev"] = int(row["pulses_per_rev"])
+        except ValueError:
+            raise ParameterError(f"pulses_per_rev={row['pulses_per_rev']!r} is not a whole number") from None
+        if row["pulses_per_rev"] < 1:
+            raise ParameterError(f"pulses_per_rev={row['pulses_per_rev']} must be >= 1")
+    if row.get("gear"):
+        row["gear"] = _gear_spec(row["gear"])
     if row.get("time"):
         import pandas as pd
         try:
@@ -189,3 +190,17 @@ def _unique(inputs: list, rows: list, manifest=None) -> tuple[list, list]:
         seen.add(key)
         items.append(it)
     return items, notes
+
+
+def _gear_spec(text: str):
+    """A manifest's gear: its teeth (``32``: an int) or its teeth and its mating gear's (``32/71``: kept as
+    that text); each at least 5."""
+    parts = str(text).strip().split("/")
+    try:
+        teeth = [int(p) for p in parts]
+    except ValueError:
+        teeth = []
+    if len(teeth) not in (1, 2) or min(teeth) < 5:
+        raise ParameterError(f"gear={text!r} must be the gear's teeth (>= 5), or its teeth and its mating gear's "
+                             "as '32/71'")
+    return teeth[0] if len(teeth) == 1 else f"{teeth[0]}/{teeth[1]}"
