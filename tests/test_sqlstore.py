@@ -398,6 +398,31 @@ def test_a_version_1_store_is_read_through_the_join_and_upgraded_by_a_writer(tar
         assert got["diagnose"]["measurement"].iloc[-1] == mid
 
 
+def test_writers_that_open_a_version_1_store_at_once_upgrade_it_once(target, tmp_path):
+    """A plant's collectors updated together each open the version-1 store for writing at the same
+    moment: one upgrades it, the others wait for it or find the work done; every writer then writes,
+    and no result is left without its asset, point and time."""
+    import sqlalchemy as sa
+    url, raw_dir = target
+    kw = {"raw_dir": raw_dir} if raw_dir else {}
+    with vm.Store(url, writable=True, **kw) as st:
+        st.add_asset("a")
+        st.add_point("a", "p")
+        for i in range(200):
+            st.add_result(st.add_measurement("a", "p", time=1.6e9 + i), "x", {"n": -i}, summary={"n": -i})
+    _as_version_1(url)
+    script = WRITER.replace("range(100000)", "range(10)")
+    args = [sys.executable, "-c", script, url] + ([str(raw_dir)] if raw_dir else [])
+    procs = [subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(4)]
+    outs = [p.communicate(timeout=300) for p in procs]
+    assert all(p.returncode == 0 for p in procs), [e[-500:] for _, e in outs]
+    with vm.Store(url, **kw) as st:
+        assert st._conn.execute(sa.text("SELECT value FROM vibmeasure WHERE key = 'schema_version'")).scalar() == "2"
+        assert st._conn.execute(sa.text("SELECT count(*) FROM results WHERE asset IS NULL")).scalar() == 0
+        got = st.results("x", asset="a")
+    assert len(got) == 240 and got["time"].is_monotonic_increasing
+
+
 def test_postgresql_reads_a_trend_from_the_covering_index_and_keeps_wide_rows(postgres, tmp_path):
     """On PostgreSQL the query a trend makes is answered from the covering index alone (an index-only
     scan: one asset's rows are adjacent there, while in the table they lie one per block); a result
