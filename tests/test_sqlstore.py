@@ -432,9 +432,13 @@ def test_postgresql_reads_a_trend_from_the_covering_index_and_keeps_wide_rows(po
     with vm.Store(url, writable=True, raw_dir=tmp_path / "raw") as st:
         st.add_asset("pump-1")
         st.add_point("pump-1", "DE")
+        rng = random.Random(3)
         for i in range(40):
             mid = st.add_measurement("pump-1", "DE", time=1.7e9 + 3600 * i)
-            note = "x" * 6000 if i == 17 else ""   # over the entry's limit even if compressed 2:1
+            # row 17 over the entry's limit even if compressed 2:1; row 23 just under the covering index's
+            # bound, in text that does not compress: its entry (with header and fixed columns) must fit
+            note = "x" * 6000 if i == 17 else "".join(rng.choice("0123456789abcdef") for _ in range(2280)) \
+                if i == 23 else ""
             st.add_result(mid, "diagnose", {"i": i}, summary={"top": "none", "confidence": 0.01 * i, "note": note})
     engine = sa.create_engine(url.replace("postgresql://", "postgresql+psycopg://"))
     with engine.connect().execution_options(isolation_level="AUTOCOMMIT") as c:
@@ -443,7 +447,12 @@ def test_postgresql_reads_a_trend_from_the_covering_index_and_keeps_wide_rows(po
     with vm.Store(url, raw_dir=tmp_path / "raw") as st:
         df = st.results("diagnose", asset="pump-1", with_result=False)
         assert df["confidence"].tolist() == pytest.approx([0.01 * i for i in range(40)], abs=1e-12)
-        assert len(df["note"].iloc[17]) == 6000
+        assert len(df["note"].iloc[17]) == 6000 and len(df["note"].iloc[23]) == 2280
+        from vibmeasure.io.sql.schema import WIDE_BYTES, _tables, _wide
+        r = _tables()["results"]
+        size = _wide(r).left   # the byte count the predicate compares
+        sizes = [v for (v,) in st._conn.execute(sa.select(size).order_by(r.c.id))]
+        assert WIDE_BYTES - 100 < sizes[23] <= WIDE_BYTES < sizes[17]
         stmt = st._results_statement(["diagnose"], "pump-1", None, 1.7e9, 1.8e9, False)
         # a table this small is read faster whole: the plain scans are ruled out to see which index serves
         # the query as the store sends it (its values bound, not written into the text)
