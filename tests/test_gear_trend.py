@@ -11,20 +11,29 @@ import vibmeasure as vm
 from vibmeasure.monitor.trend import with_na4
 
 
-def _gearbox(wear: float, seed: int) -> vm.Record:
-    """A 32-tooth mesh on the 1797 rpm shaft over a healthy machine, and the gear's own tooth-to-tooth
-    pattern (sinusoids at 95 shaft orders, none a mesh harmonic or its +-1 sidebands, random amplitudes
-    and phases fixed for the gear) at ``wear`` x its new level: many such orders sum to a Gaussian
-    residual whose FM4 stays near 3 while its variance grows as wear squared."""
+def _pattern(th: np.ndarray, teeth: int, seed: int) -> np.ndarray:
+    """A gear's own tooth-to-tooth pattern on its shaft angle ``th``: sinusoids at shaft orders 3-149, none
+    a mesh harmonic (``teeth`` x 1, 2, 3) or its +-1 sidebands, random amplitudes and phases fixed for the
+    gear (``seed``); many such orders sum to a Gaussian residual."""
+    rng = np.random.default_rng(seed)
+    k = np.arange(3, 150)
+    k = k[np.all(np.abs(k[:, None] - teeth * np.array([1, 2, 3])[None]) > 1.5, axis=1)]
+    amp, phase = rng.rayleigh(1.0, k.size), rng.uniform(0, 2 * np.pi, k.size)
+    return (amp[:, None] * np.cos(k[:, None] * th[None] + phase[:, None])).sum(0)
+
+
+def _gearbox(wear: float, seed: int, mating_wear: float = 0.0) -> vm.Record:
+    """A 32-tooth gear on the 1797 rpm shaft meshing with a 71-tooth one, over a healthy machine: the
+    mesh, the 32-tooth gear's tooth-to-tooth pattern at ``wear`` x its new level and the 71-tooth gear's
+    at ``mating_wear`` x. Wear spread over every tooth keeps each residual Gaussian (FM4 near 3) and
+    grows its variance as wear squared."""
     rec = vm.synth.machine(fault="none", seed=seed, duration=6.0)
     th = 2 * np.pi * (1797 / 60) * np.arange(rec.n_samples) / rec.fs
     mesh = sum(a * np.cos(m * 32 * th) for m, a in ((1, 1.0), (2, 1 / 3), (3, 1 / 6)))
-    rng = np.random.default_rng(1234)
-    k = np.arange(3, 100)
-    k = k[np.all(np.abs(k[:, None] - np.array([32, 64, 96])[None]) > 1.5, axis=1)]
-    amp, phase = rng.rayleigh(1.0, k.size), rng.uniform(0, 2 * np.pi, k.size)
-    pattern = (amp[:, None] * np.cos(k[:, None] * th[None] + phase[:, None])).sum(0)
-    return vm.Record.from_array(rec.data[0] + mesh + 0.02 * wear * pattern, fs=rec.fs, names=["acc"], unit="g")
+    x = rec.data[0] + mesh + 0.02 * wear * _pattern(th, 32, 1234)
+    if mating_wear:
+        x = x + 0.02 * mating_wear * _pattern(th * 32 / 71, 71, 4321)
+    return vm.Record.from_array(x, fs=rec.fs, names=["acc"], unit="g")
 
 
 def test_na4_is_fm4_scaled_by_the_residuals_growth_over_the_baseline():
@@ -84,3 +93,26 @@ def test_the_manifests_gear_is_teeth_or_teeth_and_the_mating_gears(tmp_path):
         first, second = read_manifest(m)
         assert "row 2" in first["error"] and re.search(r"gear=.*teeth \(>= 5\)", first["error"]), first
         assert second["gear"] == 32 and "error" not in second
+
+
+@pytest.mark.parametrize("worn", ["pinion", "wheel"])
+def test_na4_tells_which_of_two_meshing_gears_wears(tmp_path, worn):
+    """A 32-tooth pinion meshing with a 71-tooth wheel (manifest ``gear`` 32/71), each with its own
+    tooth-to-tooth pattern; from the eleventh measurement one of them wears (its pattern 2.5 x). Each
+    gear's NA4 comes from its own shaft's synchronous average with the other shaft's synchronous part
+    taken out first (over the 81 turns of the wheel in 6 s the pinion's orders near whole wheel orders
+    would not average away): the worn gear's NA4 alarms, the other's stays ok."""
+    rows = ["file,asset,point,rpm,bearing,gear,time"]
+    for i in range(13):
+        w = 2.5 if i >= 10 else 1.0
+        rec = _gearbox(w if worn == "pinion" else 1.0, seed=i, mating_wear=w if worn == "wheel" else 1.0)
+        path = vm.write(tmp_path / f"g{i:02d}.h5", rec)
+        rows.append(f"{path.name},gearbox-1,input,1797,6205-2RS,32/71,2026-01-{i + 1:02d}T08:00")
+    (tmp_path / "m.csv").write_text("\n".join(rows) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        vm.batch(task="diagnose", store=tmp_path / "s.db", manifest=tmp_path / "m.csv")
+    tr = vm.trend(tmp_path / "s.db").set_index("metric")
+    bad, good = ("gear_na4", "gear_mating_na4") if worn == "pinion" else ("gear_mating_na4", "gear_na4")
+    assert tr.loc[bad, "verdict"] == "alarm" and tr.loc[bad, "last"] > 10 * tr.loc[bad, "baseline_mean"]
+    assert tr.loc[good, "verdict"] == "ok", tr.loc[good, "reason"]

@@ -25,6 +25,7 @@ LABELS = {
     "velocity_rms_mm_s": "velocity RMS [mm/s]",
     "bearing_evidence": "bearing evidence [-log10 p]",
     "gear_na4": "gear NA4",
+    "gear_mating_na4": "mating gear NA4",
     "rms": "RMS",
     "zone": "ISO zone",
     "top": "diagnosis",

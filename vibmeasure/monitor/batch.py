@@ -114,12 +114,13 @@ def _run(task, rec, item, options):
             lp = [float(v) for f, v in zip(fam["fault"], fam["log10_p"])
                   if str(f).startswith("bearing_") and f != "bearing_cage" and v == v and v is not None]
             summary["bearing_evidence"] = float(-min(lp)) if lp else 0.0
-        if fam is not None and "fm4" in getattr(fam, "columns", ()):
-            # the gear's synchronous residual: its FM4 and variance (the trend's NA4 needs both)
+        if fam is not None and "shaft_fm4" in getattr(fam, "columns", ()):
+            # each shaft's synchronous residual under the gear: FM4 and variance (the trend's NA4 needs both)
             row = fam[fam["fault"] == "gear_mesh"]
-            if len(row):
-                summary["gear_fm4"] = _finite(row["fm4"].iloc[0])
-                summary["gear_residual_var"] = _finite(row["residual_var"].iloc[0])
+            for key, prefix in (("shaft", "gear"), ("mating", "gear_mating")):
+                if len(row) and f"{key}_fm4" in row:
+                    summary[f"{prefix}_fm4"] = _finite(row[f"{key}_fm4"].iloc[0])
+                    summary[f"{prefix}_residual_var"] = _finite(row[f"{key}_residual_var"].iloc[0])
         params = {"rpm": float(rpm), "bearing": item.get("bearing"), "channel": d.channel}
         return d.to_dict(), summary, (dict(params, gear=item["gear"]) if item.get("gear") else params)
     raise ParameterError(f"task {task!r} is not a per-file task")

@@ -41,12 +41,14 @@ METRICS = (
     ("diagnose", "velocity_rms_mm_s", +1, "relative", 0.5, 1.0),
     ("diagnose", "bearing_evidence", +1, "absolute", 8.0, 12.0),
     ("diagnose", "gear_na4", +1, "relative", 1 / 3, 1.0),
+    ("diagnose", "gear_mating_na4", +1, "relative", 1 / 3, 1.0),
     ("spectrum", "rms", +1, "relative", 0.5, 1.0),
     ("ringdown", "fn1_hz", 0, "relative", 0.005, 0.01),
     ("modes", "fn1_hz", 0, "relative", 0.005, 0.01),
 )
 ISO_VERDICT = {"A": 0, "B": 0, "C": 1, "D": 2}
-SOURCE = {"gear_na4": "gear_fm4"}   # a derived metric's stored column: the measurements that count toward it
+# a derived metric's stored column: the measurements that count toward it
+SOURCE = {"gear_na4": "gear_fm4", "gear_mating_na4": "gear_mating_fm4"}
 
 
 def _limits(base, direction, kind, fw, fa):
@@ -144,9 +146,11 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
 
 
 def with_na4(df, baseline_count: int):
-    """The diagnose results with ``gear_na4`` per point where they hold the gear's ``gear_fm4`` and
-    ``gear_residual_var``: FM4 x (variance / the mean variance of the point's first ``baseline_count``
-    measurements that have one)^2, NaN until that many exist. ``df`` is returned as it is without them.
+    """The diagnose results with NA4 per point for each gear whose synchronous residual they hold:
+    ``gear_na4`` from ``gear_fm4`` and ``gear_residual_var`` (the gear on the measured shaft),
+    ``gear_mating_na4`` from ``gear_mating_fm4`` and ``gear_mating_residual_var`` (its mating gear):
+    FM4 x (variance / the mean variance of the point's first ``baseline_count`` measurements that have
+    one)^2, NaN until that many exist. ``df`` is returned as it is without them.
 
     Examples
     --------
@@ -156,19 +160,22 @@ def with_na4(df, baseline_count: int):
     >>> with_na4(df, 2)["gear_na4"].tolist()
     [3.0, 3.0, 12.0]
     """
-    if df is None or df.empty or "gear_fm4" not in df or "gear_residual_var" not in df:
+    if df is None or df.empty:
         return df
     import pandas as pd
-    df = df.copy()
-    fm4 = pd.to_numeric(df["gear_fm4"], errors="coerce").to_numpy(float)
-    var = pd.to_numeric(df["gear_residual_var"], errors="coerce").to_numpy(float)
-    na4 = np.full(len(df), np.nan)
-    for idx in df.groupby(["asset", "point"], sort=False).indices.values():
-        ok = idx[np.isfinite(fm4[idx]) & np.isfinite(var[idx]) & (var[idx] > 0)]
-        if ok.size >= baseline_count:
-            na4[ok] = fm4[ok] * (var[ok] / np.mean(var[ok[:baseline_count]])) ** 2
-    df["gear_na4"] = na4
-    return df
+    out = df
+    for prefix in ("gear", "gear_mating"):
+        if f"{prefix}_fm4" not in df or f"{prefix}_residual_var" not in df:
+            continue
+        fm4 = pd.to_numeric(df[f"{prefix}_fm4"], errors="coerce").to_numpy(float)
+        var = pd.to_numeric(df[f"{prefix}_residual_var"], errors="coerce").to_numpy(float)
+        na4 = np.full(len(df), np.nan)
+        for idx in df.groupby(["asset", "point"], sort=False).indices.values():
+            ok = idx[np.isfinite(fm4[idx]) & np.isfinite(var[idx]) & (var[idx] > 0)]
+            if ok.size >= baseline_count:
+                na4[ok] = fm4[ok] * (var[ok] / np.mean(var[ok[:baseline_count]])) ** 2
+        out = out.assign(**{f"{prefix}_na4": na4})
+    return out
 
 
 def _verdict(level) -> str:
@@ -235,7 +242,8 @@ def metric_history(store, *, asset: str, point: str, metric: str, task: str | No
     asset, point : str
         The asset and its measurement point.
     metric : str
-        A trended summary column (``METRICS``: velocity_rms_mm_s, bearing_evidence, gear_na4, rms, fn1_hz).
+        A trended summary column (``METRICS``: velocity_rms_mm_s, bearing_evidence, gear_na4,
+        gear_mating_na4, rms, fn1_hz).
     task : str, optional
         The task whose results hold the metric (default: the first that has it).
     baseline_count : int

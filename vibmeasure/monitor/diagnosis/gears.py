@@ -28,19 +28,36 @@ FM4_FAULT = 4.0
 MIN_REVOLUTIONS = 10    # revolutions the synchronous average needs
 
 
-def residual_moments(x: np.ndarray, fs: float, f_shaft: float, mesh_order: float) -> tuple | None:
+def _phase_bins(n: int, fs: float, f_shaft: float, per_rev: int) -> np.ndarray:
+    """Each sample's bin of shaft phase (per_rev bins a turn) at the constant speed f_shaft."""
+    return np.minimum(((np.arange(n) * (f_shaft / fs)) % 1.0 * per_rev).astype(np.int64), per_rev - 1)
+
+
+def _synchronous_average(x: np.ndarray, j: np.ndarray, per_rev: int) -> np.ndarray:
+    return np.bincount(j, weights=x, minlength=per_rev) / np.maximum(np.bincount(j, minlength=per_rev), 1)
+
+
+def residual_moments(x: np.ndarray, fs: float, f_shaft: float, mesh_order: float, others=()) -> tuple | None:
     """(variance, FM4) of x's synchronous residual at the shaft speed f_shaft whose mesh is
     ``mesh_order`` x that speed: the samples binned by shaft phase and averaged over every revolution
     (a time-synchronous average without a tachometer, at the constant speed the analysis found), the
     regular orders taken out; FM4 is the kurtosis of what is left, the variance (the signal's unit
-    squared) what NA4 normalises by over a healthy history (``vm.trend``). None when the record holds
-    too few revolutions or too few samples per revolution for the mesh's third harmonic."""
+    squared) what NA4 normalises by over a healthy history (``vm.trend``). The synchronous part of each
+    shaft in ``others`` (their speeds) is taken out of x first: over a few dozen turns its orders near
+    whole orders of this shaft do not average away, and its gear's growth would read as this one's.
+    None when the record holds too few revolutions or too few samples per revolution for the mesh's
+    third harmonic."""
     per_rev = int(min(4096, 2 ** int(np.floor(np.log2(max(fs / f_shaft, 1.0))))))
     if per_rev < 2 * (3 * mesh_order + 3) or x.size * f_shaft / fs < MIN_REVOLUTIONS:
         return None
-    j = np.minimum(((np.arange(x.size) * (f_shaft / fs)) % 1.0 * per_rev).astype(np.int64), per_rev - 1)
-    avg = np.bincount(j, weights=x - x.mean(), minlength=per_rev) / np.maximum(np.bincount(j, minlength=per_rev), 1)
-    A = np.fft.rfft(avg)
+    x = x - x.mean()
+    # the other shafts' parts averaged on a fine grid (about 16 samples a bin, gathered from many turns):
+    # a coarse one, read back at each sample's bin, leaves a tenth of a strong pattern's high orders
+    n_fine = int(min(8192, max(per_rev, 2 ** int(np.floor(np.log2(max(x.size / 16, 1.0)))))))
+    for f_other in others:
+        j_other = _phase_bins(x.size, fs, f_other, n_fine)
+        x = x - _synchronous_average(x, j_other, n_fine)[j_other]
+    A = np.fft.rfft(_synchronous_average(x, _phase_bins(x.size, fs, f_shaft, per_rev), per_rev))
     k = np.arange(A.size)
     regular = k <= 2
     for m in MESH_HARMONICS:
@@ -127,8 +144,14 @@ def gear_rows(run) -> list:
     places = len(_places(fm, spacing, top))
     # the average needs the shaft's speed to a small part of a turn over the record: the mesh line, many
     # orders up, measures it better than the 1X (0.1 % off smears a pulse over a fifth of a turn in 180)
-    order = fm / spacing
-    var, fm4 = residual_moments(run.job.a, run.job.fs, mesh_f / order, order) or (None, None)
+    # each shaft's synchronous residual (this shaft's gear has ``teeth``, the mating one teeth / ratio),
+    # the other shaft's part taken out: FM4 of the winning shaft's judges the call; NA4 trends one gear
+    # over many records, so the summary keeps each shaft's, whichever won
+    moments = {n: residual_moments(run.job.a, run.job.fs, mesh_f * s / fm, fm / s,
+                                   [mesh_f * o / fm for m, o in shafts if m != n]) or (None, None) for n, s in shafts}
+    fm4 = moments[name][1]
+    per_shaft = {f"{key}_{what}": moments[n][i] for key, (n, _) in zip(("shaft", "mating"), shafts)
+                 for i, what in ((1, "fm4"), (0, "residual_var"))}
     note = (f"mesh {gear.teeth} x 1X at {mesh_db:.0f} dB; wide sidebands (+-2..6 x {name}'s {spacing:.2f} Hz) stand "
             f"in {c} of {places} places more than halfway between the mesh harmonics, decoy spacings p = {p:.2g}"
             + "".join(f"; {n}: {counts[n]}" for n, _ in shafts if n != name)
@@ -141,4 +164,4 @@ def gear_rows(run) -> list:
                  "or a wandering speed")
         run.job.flags.append("gear_not_impulsive")
     return [_row("gear_mesh", fm, mesh_f, mesh_amp, mesh_db, score, note, sidebands=c, decoy_p=p, fm4=fm4,
-                 residual_var=var)]
+                 **per_shaft)]
