@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .lines import LINE_DB, _line, _row
+from .lines import LINE_DB, _line, _refine, _row
 
 MESH_HARMONICS = (1, 2, 3)
 WIDE_SIDEBANDS = (2, 3, 4, 5, 6)   # +-1 belongs to the healthy mesh; a tooth's pulse spreads to these
@@ -144,14 +144,20 @@ def gear_rows(run) -> list:
     places = len(_places(fm, spacing, top))
     # the average needs the shaft's speed to a small part of a turn over the record: the mesh line, many
     # orders up, measures it better than the 1X (0.1 % off smears a pulse over a fifth of a turn in 180)
-    # each shaft's synchronous residual (this shaft's gear has ``teeth``, the mating one teeth / ratio),
-    # the other shaft's part taken out: FM4 of the winning shaft's judges the call; NA4 trends one gear
-    # over many records, so the summary keeps each shaft's, whichever won
-    moments = {n: residual_moments(run.job.a, run.job.fs, mesh_f * s / fm, fm / s,
-                                   [mesh_f * o / fm for m, o in shafts if m != n]) or (None, None) for n, s in shafts}
-    fm4 = moments[name][1]
-    per_shaft = {f"{key}_{what}": moments[n][i] for key, (n, _) in zip(("shaft", "mating"), shafts)
-                 for i, what in ((1, "fm4"), (0, "residual_var"))}
+    order = fm / spacing
+    fm4 = (residual_moments(run.job.a, run.job.fs, mesh_f / order, order) or (None, None))[1]
+    # for NA4 (``vm.trend``), each gear's residual on its own shaft, whichever won: this shaft's gear has
+    # ``teeth``, the mating one teeth / ratio. The other shaft's synchronous part is taken out first, and
+    # the speed comes from the mesh line refined between bins: a bin's width (1/T) is 1/(T fm) of the
+    # speed, which over the record drifts order k by k / fm turns, a whole turn at the mesh's own order.
+    # (The call's FM4 above keeps the bin's speed: its threshold was set with it, and a sharper average
+    # keeps more of a run-out's +-2, 3 x 1X sidebands: 4.3 on one such synthetic record, over the 4.)
+    hz = _refine(f, A, mesh_f)
+    per_shaft = {}
+    for key, (n, s) in zip(("shaft", "mating"), shafts):
+        var_k, fm4_k = residual_moments(run.job.a, run.job.fs, hz * s / fm, fm / s,
+                                        [hz * o / fm for m, o in shafts if m != n]) or (None, None)
+        per_shaft.update({f"{key}_fm4": fm4_k, f"{key}_residual_var": var_k})
     note = (f"mesh {gear.teeth} x 1X at {mesh_db:.0f} dB; wide sidebands (+-2..6 x {name}'s {spacing:.2f} Hz) stand "
             f"in {c} of {places} places more than halfway between the mesh harmonics, decoy spacings p = {p:.2g}"
             + "".join(f"; {n}: {counts[n]}" for n, _ in shafts if n != name)
