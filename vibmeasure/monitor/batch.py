@@ -1,9 +1,10 @@
 """Batch analysis into a measurement store, serially or on a Dask cluster.
 
 Inputs are files, folders and globs, with an optional manifest (CSV: ``file`` (name or glob relative
-to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``gear`` (teeth, or teeth/mating teeth), ``model``,
-``time``, ``unit`` and ``fs`` (for files that do not state them), and for a speed that varies ``tach``
-(the tachometer channel) and ``pulses_per_rev``). A manifest row's ``channel`` is the point's sensor: the only one analysed.
+to the manifest), ``asset``, ``point``, ``channel``, ``rpm``, ``bearing``, ``gear`` (teeth, or teeth/mating
+teeth), ``model``, ``time``, ``unit`` and ``fs`` (for files that do not state them), and for a speed that
+varies ``tach`` (the tachometer channel) and ``pulses_per_rev``). A manifest row's ``channel`` is the
+point's sensor: the only one analysed.
 Each input is read and analysed by a pure function (:func:`analyse_file`) that returns plain data;
 with Dask the workers run it and only the client writes the store, committing every few dozen
 results. One bad file never stops the batch: its error is stored and listed. An input whose content

@@ -17,11 +17,12 @@ with fewer measurements than the baseline needs is listed ("no baseline yet") wi
 say, never left out. A measurement analysed again (``batch(force=True)``) counts once, by its
 latest result.
 
-NA4 (Zakrajsek 1993, in the form normalised by a healthy history): the gear's synchronous residual
-kurtosis with the current residual's fourth moment over the square of the baseline's mean variance,
-``gear_na4 = FM4 x (variance / baseline mean variance)^2``. FM4 stays near 3 as damage spreads over
-every tooth (the residual grows but stays Gaussian); NA4 keeps growing with the residual's level.
-Watch at 4/3 of the baseline's NA4 (FM4's fault threshold, 4, over a healthy 3), alarm at twice it.
+NA4 (Zakrajsek 1993, in the form normalised by a healthy history), per gear (``gear_na4`` on the
+measured shaft, ``gear_mating_na4`` on its mating one): the fourth moment of the gear's synchronous
+residual over the square of the baseline's mean variance, ``FM4 x (variance / baseline mean
+variance)^2``. FM4 stays near 3 as damage spreads over every tooth (the residual grows but stays
+Gaussian); NA4 grows with the residual's level. Watch at 4/3 of the baseline's NA4 (FM4's fault
+threshold, 4, over a healthy 3), alarm at twice it.
 """
 
 from __future__ import annotations
