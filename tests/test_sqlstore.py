@@ -244,6 +244,37 @@ def test_batch_and_trend_on_a_database_store(tmp_path):
     assert len(vm.Store(tmp_path / "s.db").results("spectrum")) == 4
 
 
+def test_a_batch_reads_only_its_inputs_rows_to_skip_them(tmp_path, monkeypatch):
+    """The skip rule asks the database for the measurements of the inputs' contents (the sha256 index)
+    and for those measurements' tasks, never for every measurement: a store of a million measurements
+    took 10.7 s to read whole (PostgreSQL) before a batch of a few files could start. A new input beside
+    stored ones is analysed, the stored ones with every task done are skipped, one missing a task gets
+    that task only."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    for i in range(3):
+        vm.write(folder / f"r{i}.h5", vm.synth.machine(rpm=1500.0, fs=12800.0, duration=1.0, seed=i))
+    with vm.Store(tmp_path / "s.db", writable=True) as st:   # other assets' history the batch must not read
+        st.add_asset("other")
+        st.add_point("other", "p")
+        for k in range(300):
+            st.add_result(st.add_measurement("other", "p", time=1.6e9 + k, sha256=f"{k:064x}"), "spectrum", {})
+    vm.batch([folder / "r0.h5", folder / "r1.h5"], task="spectrum", store=tmp_path / "s.db")
+    vm.batch([folder / "r1.h5"], task="diagnose", store=tmp_path / "s.db")
+
+    def whole(*args, **kwargs):
+        raise AssertionError("the batch read every measurement")
+    monkeypatch.setattr(SQLStore, "measurements", whole)
+    rep = vm.batch([folder], task="spectrum+diagnose", store=tmp_path / "s.db").set_index("file")
+    status = {k.rsplit("/", 1)[-1]: v for k, v in rep["status"].items()}
+    assert status == {"r0.h5": "done", "r1.h5": "skipped", "r2.h5": "done"}, rep
+    monkeypatch.undo()
+    con = sqlite3.connect(tmp_path / "s.db")
+    rows = dict(con.execute("SELECT task, count(*) FROM results WHERE asset != 'other' GROUP BY task").fetchall())
+    con.close()
+    assert rows == {"spectrum": 3, "diagnose": 3}   # r0's spectrum was not analysed again, only its diagnosis
+
+
 class _Buf:
     def __init__(self):
         self.parts = []

@@ -344,13 +344,24 @@ class _Queries:
                     return row["id"]
         return None
 
-    def _measurements_with(self, tasks) -> dict:
-        """task -> the ids of the measurements with a result of it (one pass over the rows, no frame)."""
+    def _measurements_with(self, tasks, ids=None) -> dict:
+        """task -> the ids of the measurements (of ``ids``, or all) with a result of it (one pass over the
+        rows, no frame)."""
         out = {t: set() for t in tasks}
+        keep = None if ids is None else set(ids)
         for r in self._each("results"):
-            if r["task"] in out:
+            if r["task"] in out and (keep is None or r["measurement"] in keep):
                 out[r["task"]].add(r["measurement"])
         return out
+
+    def _with_contents(self, shas) -> list:
+        """(measurement id, sha256, asset, point) of the stored measurements of these content hashes,
+        oldest first."""
+        want = set(shas)
+        if not want:
+            return []
+        m = self.measurements()
+        return [row for row in zip(m["id"], m["sha256"], m["asset"], m["point"]) if row[1] in want]
 
     def _known(self, measurement) -> bool:
         if measurement in self._pending_meas:

@@ -347,15 +347,21 @@ def batch(inputs=(), *, task="diagnose", store, manifest=None, client=None, work
     rows = [(f, "skipped", None, m) for f, m in notes] + [(it["file"], "error", None, it["error"]) for it in bad]
     todo = []
     try:
-        stored = _Stored(st, tasks) if st.n_measurements else None
+        shas = {}
+        if st.n_measurements:   # the skip rule reads what the store holds of these inputs' contents only
+            for it in items:
+                try:
+                    shas[it["file"]] = file_sha256(it["file"])
+                except (OSError, VibMeasureError) as exc:
+                    shas[it["file"]] = exc
+        stored = _Stored(st, tasks, [v for v in shas.values() if isinstance(v, str)]) if shas else None
         for it in items:
             if stored is None:
                 todo.append(it)
                 continue
-            try:
-                sha = file_sha256(it["file"])
-            except (OSError, VibMeasureError) as exc:
-                rows.append((it["file"], "error", None, str(exc)))
+            sha = shas[it["file"]]
+            if not isinstance(sha, str):
+                rows.append((it["file"], "error", None, str(sha)))
                 continue
             mid, missing = stored.find(sha, it)
             if mid is not None and not missing and not force:
@@ -443,21 +449,22 @@ def _record_alarms(st, assets) -> None:
 
 
 class _Stored:
-    """What a store holds for a batch's skip rule: per content hash and asset, the measurements (point,
-    id), and per measurement the tasks with a result (an error is no result)."""
+    """What a store holds for a batch's skip rule, of the inputs' contents (``shas``) only: per content
+    hash and asset, the measurements (point, id), and per measurement the tasks with a result (an error
+    is no result). A store of a million measurements is not read whole to skip a few dozen inputs."""
 
-    def __init__(self, st, tasks):
-        m = st.measurements()
+    def __init__(self, st, tasks, shas):
         self.by_content: dict = {}
-        for mid, sha, asset, point in zip(m["id"], m["sha256"], m["asset"], m["point"]):
-            if sha:
-                self.by_content.setdefault((sha, asset), []).append((point, mid))
+        for mid, sha, asset, point in st._with_contents(shas):
+            self.by_content.setdefault((sha, asset), []).append((point, mid))
         wanted = [t for t in tasks if t not in ("compare", "auto")] or list(TASKS)
         self.tasks = [t for t in tasks if t != "auto"]
         self.any_task = "auto" in tasks
         self.done: dict = {}
-        # ids only (a store of a million results is not parsed to learn which inputs are done)
-        for t, mids in st._measurements_with(sorted(set(wanted) | (set(TASKS) if self.any_task else set()))).items():
+        ids = [mid for hits in self.by_content.values() for _, mid in hits]
+        # ids only (no result is parsed to learn which inputs are done)
+        for t, mids in st._measurements_with(sorted(set(wanted) | (set(TASKS) if self.any_task else set())),
+                                             ids).items():
             for mid in mids:
                 self.done.setdefault(mid, set()).add(t)
 

@@ -8,6 +8,9 @@ from .._store_common import ALARM_COLUMNS, TASK_ALIASES, _seconds
 from .schema import _RAW_KEY, _loads, _many, _mid, _mnum, _tables, _wide
 
 
+CHUNK = 500   # values in one IN (...) list: well under SQLite's and the drivers' parameter limits
+
+
 class _SQLQueries:
     """Methods of :class:`SQLStore` that read; SQLStore inherits them."""
 
@@ -231,15 +234,33 @@ class _SQLQueries:
         self._end_read()
         return None if n is None else _mid(n)
 
-    def _measurements_with(self, tasks) -> dict:
-        """task -> the ids of the measurements with a result of it (ids only: no JSON is parsed)."""
+    def _measurements_with(self, tasks, ids=None) -> dict:
+        """task -> the ids of the measurements (of ``ids``, or all) with a result of it (ids only: no JSON
+        is parsed)."""
         import sqlalchemy as sa
         r = _tables()["results"]
         out = {t: set() for t in tasks}
-        for m, t in self._run(sa.select(r.c.measurement, r.c.task).where(r.c.task.in_(list(tasks))).distinct()):
-            out[t].add(_mid(m))
+        stmt = sa.select(r.c.measurement, r.c.task).where(r.c.task.in_(list(tasks))).distinct()
+        nums = None if ids is None else sorted({n for n in map(_mnum, ids) if n is not None})
+        for chunk in ([None] if nums is None else [nums[i:i + CHUNK] for i in range(0, len(nums), CHUNK)]):
+            for m, t in self._run(stmt if chunk is None else stmt.where(r.c.measurement.in_(chunk))):
+                out[t].add(_mid(m))
         self._end_read()
         return out
+
+    def _with_contents(self, shas) -> list:
+        """(measurement id, sha256, asset, point) of the stored measurements of these content hashes,
+        oldest first as ``measurements`` orders them (by time, then id; through the sha256 index: a
+        batch's skip rule reads only its inputs' rows)."""
+        import sqlalchemy as sa
+        m = _tables()["measurements"]
+        want = sorted(set(shas))
+        rows = []
+        for i in range(0, len(want), CHUNK):
+            stmt = sa.select(m.c.time, m.c.id, m.c.sha256, m.c.asset, m.c.point).where(m.c.sha256.in_(want[i:i + CHUNK]))
+            rows += self._run(stmt).all()
+        self._end_read()
+        return [(_mid(n), sha, asset, point) for _, n, sha, asset, point in sorted(rows, key=lambda r: r[:2])]
 
     def _located(self, measurement) -> tuple | None:
         """(asset, point, time) of a stored measurement, or None for an id the store does not hold."""
