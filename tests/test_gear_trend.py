@@ -48,6 +48,12 @@ def test_na4_is_fm4_scaled_by_the_residuals_growth_over_the_baseline():
     np.testing.assert_allclose(got[:5], [3.0 / 4, np.nan, 4.0 * 9 / 4, 3.0, 5.0 * 4], rtol=1e-12)
     np.testing.assert_allclose(got[5:], [3.0, 3.0], rtol=1e-12)
     assert "gear_na4" not in with_na4(df.drop(columns="gear_fm4"), 2)
+    for bad in (0, 1, 1.5, True, "8"):
+        with pytest.raises(vm.ParameterError, match="baseline_count=.* must be an integer >= 2"):
+            with_na4(df, bad)
+    for bad in ([1, 2], df.drop(columns="point")):
+        with pytest.raises(vm.ParameterError, match="df must be a results DataFrame with asset and point"):
+            with_na4(bad, 2)
 
 
 @pytest.mark.parametrize("wear", [1.0, 2.5])

@@ -112,8 +112,7 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
     import pandas as pd
     from ..io.store import Store, is_store
     st = store if is_store(store) else Store(store)
-    if isinstance(baseline_count, bool) or not isinstance(baseline_count, (int, np.integer)) or baseline_count < 2:
-        raise ParameterError(f"baseline_count={baseline_count!r} must be an integer >= 2")
+    _check_baseline_count(baseline_count)
     rows = []
     # one row per measurement: a measurement analysed again counts once, by its latest result
     # (the summary values only: the full result documents are most of a long history's query time)
@@ -146,12 +145,23 @@ def trend(store, *, asset: str | None = None, point: str | None = None, baseline
     return out.drop(columns="level")
 
 
+def _check_baseline_count(baseline_count) -> None:
+    if isinstance(baseline_count, bool) or not isinstance(baseline_count, (int, np.integer)) or baseline_count < 2:
+        raise ParameterError(f"baseline_count={baseline_count!r} must be an integer >= 2")
+
+
 def with_na4(df, baseline_count: int):
     """The diagnose results with NA4 per point for each gear whose synchronous residual they hold:
     ``gear_na4`` from ``gear_fm4`` and ``gear_residual_var`` (the gear on the measured shaft),
     ``gear_mating_na4`` from ``gear_mating_fm4`` and ``gear_mating_residual_var`` (its mating gear):
     FM4 x (variance / the mean variance of the point's first ``baseline_count`` measurements that have
     one)^2, NaN until that many exist. ``df`` is returned as it is without them.
+
+    Raises
+    ------
+    ParameterError
+        For a baseline_count that is not an integer >= 2, or a df that is not a DataFrame with asset
+        and point columns.
 
     Examples
     --------
@@ -161,9 +171,15 @@ def with_na4(df, baseline_count: int):
     >>> with_na4(df, 2)["gear_na4"].tolist()
     [3.0, 3.0, 12.0]
     """
-    if df is None or df.empty:
-        return df
     import pandas as pd
+    _check_baseline_count(baseline_count)
+    if df is None:
+        return df
+    if not isinstance(df, pd.DataFrame) or not (df.empty or {"asset", "point"} <= set(df.columns)):
+        raise ParameterError(f"df must be a results DataFrame with asset and point columns; got "
+                             f"{type(df).__name__}{' without them' if isinstance(df, pd.DataFrame) else ''}")
+    if df.empty:
+        return df
     out = df
     for prefix in ("gear", "gear_mating"):
         if f"{prefix}_fm4" not in df or f"{prefix}_residual_var" not in df:
