@@ -1087,8 +1087,10 @@ def test_gear_sidebands_without_an_impulsive_residual_are_held():
     by 1 + 0.5 cos + 0.4 cos 2 + 0.3 cos 3 of the shaft angle) stands at +-2 and +-3 x 1X around each mesh
     harmonic and beats the decoy spacings, and was called gear_mesh at 1.00. A tooth fault's once-a-turn
     pulse makes the synchronous average's residual impulsive (FM4 7-10 on synthetic faults, 3 for a
-    Gaussian residue); a smooth modulation leaves it near 3: the call is held at 0.45 (flag
-    gear_not_impulsive), the FM4 named in the row."""
+    Gaussian residue); a smooth modulation leaves it near 3: no gear call (flag gear_not_impulsive), the
+    FM4 named in the row. With the speed refined from the mesh line the average is
+    sharp and the run-out reads FM4 4.3, over the 4: what holds it is that residuals of the same sideband
+    spectrum with random timing read as high (p 0.39-0.45), while a tooth fault's beats all 399 of them."""
     for seed in range(3):
         rec = vm.synth.machine(fault="none", seed=seed, duration=6.0)
         t = np.arange(rec.n_samples) / rec.fs
@@ -1098,10 +1100,11 @@ def test_gear_sidebands_without_an_impulsive_residual_are_held():
         r = vm.Record.from_array(rec.data[0] + mesh * mod, fs=rec.fs, names=["acc"], unit="g")
         d = vm.diagnose(r, rpm=1797, bearing="6205-2RS", gear=32)
         row = d.faults.set_index("fault").loc["gear_mesh"]
-        assert row.sidebands >= 10 and row.decoy_p < 0.05 and row.fm4 < 3.7, (row.sidebands, row.fm4)
-        assert d.top != "gear_mesh" and "gear_not_impulsive" in d.flags and "not impulsive" in row.note
+        assert row.sidebands >= 10 and row.decoy_p < 0.05 and row.fm4_p > 0.1, (row.sidebands, row.fm4, row.fm4_p)
+        assert d.top != "gear_mesh" and "gear_not_impulsive" in d.flags and "no more impulsive than random" in row.note
         fault = vm.diagnose(vm.synth.machine(fault="gear_mesh", seed=seed, duration=6.0), bearing="6205-2RS", gear=32)
-        assert fault.top == "gear_mesh" and fault.faults.set_index("fault").loc["gear_mesh"].fm4 > 6
+        frow = fault.faults.set_index("fault").loc["gear_mesh"]
+        assert fault.top == "gear_mesh" and frow.fm4 > 6 and frow.fm4_p == 1 / 400
 
 
 def _at_half_and_own_rate(path):

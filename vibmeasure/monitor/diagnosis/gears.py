@@ -26,6 +26,13 @@ DECOY_P = 0.05          # the shaft's count must beat this share of decoy spacin
 # an off-centre gear: 3.1-3.5 with +-2, 3 x 1X sidebands) or a speed that wanders: the call is held.
 FM4_FAULT = 4.0
 MIN_REVOLUTIONS = 10    # revolutions the synchronous average needs
+# FM4 must also beat residuals of the same sideband spectrum with random timing (``impulsiveness``):
+# synthetic healthy gears with random tooth errors of 2-10 % read p >= 0.01, a tooth 0.3-1 x the mesh
+# amplitude off (errors 2-5 %) p = 1 / (1 + N_SURROGATES), beyond every surrogate
+N_SURROGATES = 399
+IMPULSE_P = 0.005
+TOOTH_ERRORS_P = 0.05   # above it, the residual is as random tooth errors make it: wide sidebands are no fault
+SURROGATE_SEED = 20261129
 
 
 def _phase_bins(n: int, fs: float, f_shaft: float, per_rev: int) -> np.ndarray:
@@ -37,17 +44,12 @@ def _synchronous_average(x: np.ndarray, j: np.ndarray, per_rev: int) -> np.ndarr
     return np.bincount(j, weights=x, minlength=per_rev) / np.maximum(np.bincount(j, minlength=per_rev), 1)
 
 
-def residual_moments(x: np.ndarray, fs: float, f_shaft: float, mesh_order: float, others=()) -> tuple | None:
-    """(variance, FM4) of x's synchronous residual at the shaft speed f_shaft whose mesh is
-    ``mesh_order`` x that speed: the samples binned by shaft phase and averaged over every revolution
-    (a time-synchronous average without a tachometer, at the constant speed the analysis found), the
-    regular orders taken out; FM4 is the kurtosis of what is left, the variance (the signal's unit
-    squared) what NA4 normalises by over a healthy history (``vm.trend``). The synchronous part of each
-    shaft in ``others`` (their speeds) is taken out of x first: over a few dozen turns its orders near
-    whole orders of this shaft do not average away, and its gear's growth would read as this one's.
-    None when the record holds too few revolutions or too few samples per revolution for the mesh's
-    third harmonic."""
+def _residual(x: np.ndarray, fs: float, f_shaft: float, mesh_order: float, others=()) -> tuple | None:
+    """(order spectrum, samples a turn) of x's synchronous residual at f_shaft (``residual_moments``)."""
+    # a power of two a turn where it holds the mesh's third harmonic, else every sample a turn offers
     per_rev = int(min(4096, 2 ** int(np.floor(np.log2(max(fs / f_shaft, 1.0))))))
+    if per_rev < 2 * (3 * mesh_order + 3):
+        per_rev = 2 * int(fs / f_shaft / 2)
     if per_rev < 2 * (3 * mesh_order + 3) or x.size * f_shaft / fs < MIN_REVOLUTIONS:
         return None
     x = x - x.mean()
@@ -63,9 +65,60 @@ def residual_moments(x: np.ndarray, fs: float, f_shaft: float, mesh_order: float
     for m in MESH_HARMONICS:
         regular |= np.abs(k - m * mesh_order) <= 1.5
     A[regular] = 0
-    d = np.fft.irfft(A, per_rev)
-    power = float(np.sum(d ** 2))
-    return (power / per_rev, float(per_rev * np.sum(d ** 4) / power ** 2)) if power > 0 else None
+    return A, per_rev
+
+
+def _kurtosis(A: np.ndarray, n: int) -> np.ndarray:
+    """Kurtosis of the waveform(s) whose half spectrum is A (last axis), a turn of n samples."""
+    d = np.fft.irfft(A, n, axis=-1)
+    power = np.sum(d ** 2, axis=-1)
+    return n * np.sum(d ** 4, axis=-1) / np.where(power > 0, power, np.inf) ** 2
+
+
+def residual_moments(x: np.ndarray, fs: float, f_shaft: float, mesh_order: float, others=()) -> tuple | None:
+    """(variance, FM4) of x's synchronous residual at the shaft speed f_shaft whose mesh is
+    ``mesh_order`` x that speed: the samples binned by shaft phase and averaged over every revolution
+    (a time-synchronous average without a tachometer, at the constant speed the analysis found), the
+    regular orders taken out; FM4 is the kurtosis of what is left, the variance (the signal's unit
+    squared) what NA4 normalises by over a healthy history (``vm.trend``). The synchronous part of each
+    shaft in ``others`` (their speeds) is taken out of x first: over a few dozen turns its orders near
+    whole orders of this shaft do not average away, and its gear's growth would read as this one's.
+    None when the record holds too few revolutions or too few samples per revolution for the mesh's
+    third harmonic."""
+    res = _residual(x, fs, f_shaft, mesh_order, others)
+    if res is None:
+        return None
+    A, per_rev = res
+    power = float(np.sum(np.fft.irfft(A, per_rev) ** 2))
+    return (power / per_rev, float(_kurtosis(A, per_rev))) if power > 0 else None
+
+
+def impulsiveness(x: np.ndarray, fs: float, f_shaft: float, mesh_order: float) -> tuple | None:
+    """(FM4, p): the synchronous residual's kurtosis and how unusual it is among N_SURROGATES residuals
+    with the same sideband spectrum and random timing. Every real gear's teeth differ a little (pitch,
+    profile, stiffness): that modulates the mesh at every order of the shaft, and a modulated carrier is
+    not Gaussian (a carrier times a Gaussian modulation has kurtosis 4.5), so FM4 alone reads 4-14 on
+    synthetic gears with random tooth errors of 2-10 %. A local fault differs in timing, not in spectrum:
+    its sidebands are in phase (one pulse a turn). Each surrogate keeps every order's magnitude and
+    delays the modulation's order k at random, the same delay for the pair (mesh harmonic h x teeth +- k)
+    and for every h, so that an amplitude or phase modulation stays one, with its kurtosis; orders below
+    half the mesh get random phases. p = (1 + surrogates at or above FM4) / (1 + N_SURROGATES)."""
+    res = _residual(x, fs, f_shaft, mesh_order)
+    if res is None:
+        return None
+    A, n = res
+    o = np.arange(A.size)
+    h = np.rint(o / mesh_order).astype(int)
+    k = o - np.rint(h * mesh_order).astype(int)
+    rng = np.random.default_rng(SURROGATE_SEED)
+    delay = rng.uniform(0, 2 * np.pi, (N_SURROGATES, int(np.abs(k).max()) + 1))
+    free = rng.uniform(0, 2 * np.pi, (N_SURROGATES, A.size))
+    phase = np.where(h[None, :] == 0, free, np.sign(k)[None, :] * delay[:, np.abs(k)])
+    if n % 2 == 0:
+        phase[:, -1] = 0.0   # the Nyquist order of an even turn stays real
+    observed = float(_kurtosis(A, n))
+    surrogates = _kurtosis(A[None, :] * np.exp(1j * phase), n)
+    return observed, float((1 + np.sum(surrogates >= observed)) / (1 + N_SURROGATES))
 
 
 def _heights(A: np.ndarray, df: float, hz: np.ndarray, tol: int, ring: int) -> np.ndarray:
@@ -104,6 +157,30 @@ def _decoys(f1: float, shafts: list) -> np.ndarray:
     return u[:: max(1, u.size // N_DECOYS)][:N_DECOYS]
 
 
+def _winner(run, shafts: list, counts: dict, decoy: np.ndarray, hz: float, fm: float):
+    """(shaft, its count, decoy p, whether its sidebands stand, (FM4, p) of its residual). A shaft whose
+    wide sidebands stand against the decoys and whose synchronous residual is impulsive (FM4 >= FM4_FAULT
+    and p <= IMPULSE_P) is the faulty gear's; else the shaft with more sidebands, standing only when it
+    has more than the other. Both residuals are tested: the gear with more sidebands is not always the
+    faulty one (a 71-tooth wheel's random tooth errors spread more sidebands than a pinion's broken
+    tooth)."""
+    tests = {}
+    for name, s in shafts:
+        c = counts[name]
+        p = float((1 + np.sum(decoy >= c)) / (1 + decoy.size))
+        tests[name] = (c, p, c >= MIN_SIDEBANDS and p <= DECOY_P,
+                       impulsiveness(run.job.a, run.job.fs, hz * s / fm, fm / s) or (None, None))
+    local = [n for n, (c, p, ok, (k, kp)) in tests.items() if ok and k is not None and k >= FM4_FAULT
+             and kp <= IMPULSE_P]
+    if local:
+        name = max(local, key=lambda n: tests[n][3][0])
+        c, p, _, fm4 = tests[name]
+        return name, c, p, True, fm4
+    name = max(tests, key=lambda n: tests[n][0])
+    c, p, ok, fm4 = tests[name]
+    return name, c, p, ok and all(c > counts[n] for n in counts if n != name), fm4
+
+
 def gear_rows(run) -> list:
     """The gear row where a gear is given: the mesh line, and a fault where one shaft's wide sidebands
     (+-2..6 x its speed around mesh harmonics 1-3, less those standing halfway between the harmonics)
@@ -136,23 +213,16 @@ def gear_rows(run) -> list:
               for name, s in shafts}
     decoy = np.array([_count(A, df, fm, u, top, tol, ring) - _count(A, df, fm, u, top, tol, ring, -0.5)
                       for u in _decoys(f1, [s for _, s in shafts])])
-    (name, spacing), c = max(((n, s) for n, s in shafts), key=lambda ns: counts[ns[0]]), max(counts.values())
-    p = float((1 + np.sum(decoy >= c)) / (1 + decoy.size))
-    other = [counts[n] for n, _ in shafts if n != name]
-    stands = c >= MIN_SIDEBANDS and p <= DECOY_P and all(c > o for o in other)
+    # the average needs the shaft's speed to a small part of a turn over the record: the mesh line, many
+    # orders up and refined between bins, measures it better than the 1X (0.1 % off smears a pulse over a
+    # fifth of a turn in 180; a bin's width, 1/T, drifts order k by k / fm turns over the record)
+    hz = _refine(f, A, mesh_f)
+    name, c, p, stands, (fm4, fm4_p) = _winner(run, shafts, counts, decoy, hz, fm)
+    spacing = dict(shafts)[name]
     score = (1 - p) * min(1.0, c / (MIN_SIDEBANDS + 2)) if stands else 0.0
     places = len(_places(fm, spacing, top))
-    # the average needs the shaft's speed to a small part of a turn over the record: the mesh line, many
-    # orders up, measures it better than the 1X (0.1 % off smears a pulse over a fifth of a turn in 180)
-    order = fm / spacing
-    fm4 = (residual_moments(run.job.a, run.job.fs, mesh_f / order, order) or (None, None))[1]
     # for NA4 (``vm.trend``), each gear's residual on its own shaft, whichever won: this shaft's gear has
-    # ``teeth``, the mating one teeth / ratio. The other shaft's synchronous part is taken out first, and
-    # the speed comes from the mesh line refined between bins: a bin's width (1/T) is 1/(T fm) of the
-    # speed, which over the record drifts order k by k / fm turns, a whole turn at the mesh's own order.
-    # (The call's FM4 above keeps the bin's speed: its threshold was set with it, and a sharper average
-    # keeps more of a run-out's +-2, 3 x 1X sidebands: 4.3 on one such synthetic record, over the 4.)
-    hz = _refine(f, A, mesh_f)
+    # ``teeth``, the mating one teeth / ratio; the other shaft's synchronous part is taken out first
     per_shaft = {}
     for key, (n, s) in zip(("shaft", "mating"), shafts):
         var_k, fm4_k = residual_moments(run.job.a, run.job.fs, hz * s / fm, fm / s,
@@ -161,13 +231,22 @@ def gear_rows(run) -> list:
     note = (f"mesh {gear.teeth} x 1X at {mesh_db:.0f} dB; wide sidebands (+-2..6 x {name}'s {spacing:.2f} Hz) stand "
             f"in {c} of {places} places more than halfway between the mesh harmonics, decoy spacings p = {p:.2g}"
             + "".join(f"; {n}: {counts[n]}" for n, _ in shafts if n != name)
-            + (f"; FM4 {fm4:.2f} ({name}'s synchronous average, regular mesh removed)" if fm4 is not None else "")
+            + (f"; FM4 {fm4:.2f} ({name}'s synchronous average, regular mesh removed; p = {fm4_p:.2g} among "
+               "residuals of its sideband spectrum with random timing)" if fm4 is not None else "")
             + ("" if stands else "; a healthy mesh (only its +-1 sidebands and a few others)"))
-    if stands and fm4 is not None and fm4 < FM4_FAULT:
+    if stands and fm4 is not None and fm4_p > TOOTH_ERRORS_P:
+        score = 0.0
+        note += ("; not a fault: the synchronous residual is no more impulsive than random tooth-to-tooth errors "
+                 f"of the same sideband spectrum make it (p > {TOOTH_ERRORS_P:g}), as on a healthy gear")
+        run.job.flags.append("gear_not_impulsive")
+    elif stands and (fm4 is None or fm4 < FM4_FAULT or fm4_p > IMPULSE_P):
         score = min(score, 0.45)
-        note += (f"; held at 0.45: the synchronous residual is not impulsive (FM4 < {FM4_FAULT:g}), as a local "
-                 "tooth fault makes it: a distributed modulation (an eccentric or off-centre gear, load changes) "
-                 "or a wandering speed")
+        why = ("no synchronous average: too few turns, or too few samples a turn for the mesh's third harmonic"
+               if fm4 is None else f"FM4 < {FM4_FAULT:g}" if fm4 < FM4_FAULT else
+               f"p > {IMPULSE_P:g} among residuals with random timing")
+        note += (f"; held at 0.45: the synchronous residual is not clearly impulsive ({why}), as a local tooth "
+                 "fault makes it: random tooth errors, a distributed modulation (an eccentric or off-centre gear, "
+                 "load changes) or a wandering speed")
         run.job.flags.append("gear_not_impulsive")
     return [_row("gear_mesh", fm, mesh_f, mesh_amp, mesh_db, score, note, sidebands=c, decoy_p=p, fm4=fm4,
-                 **per_shaft)]
+                 fm4_p=fm4_p, **per_shaft)]
