@@ -37,6 +37,9 @@ BINS = [0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 1.0001]
 STRESS = [  # (label, synth.machine keywords, bearing, answers that are acceptable)
     # every working gearbox carries a mesh with +-1X sidebands: no gear fault (gear=32 declared)
     ("healthy gearbox, mesh 1 g", dict(fault="none", mesh=1.0), "6205-2RS", {"none"}),
+    # every real gear's teeth differ: sidebands at every order, FM4 4-8, and still no gear fault
+    ("healthy gearbox, mesh 1 g, 5 % tooth errors", dict(fault="none", mesh=1.0, tooth_error=0.05), "6205-2RS",
+     {"none"}),
     ("outer race in a gearbox, mesh 0.5 g", dict(fault="bearing_outer_race", mesh=0.5), "6205-2RS",
      {"bearing_outer_race"}),
     ("healthy, strong cage-rate modulation", dict(fault="none", cage_modulation=1.0), "6205-2RS", {"none"}),
