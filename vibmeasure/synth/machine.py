@@ -45,7 +45,7 @@ _KAISER_BETA = 12.0  # its window: the delay is exact to 1e-3 up to 0.45 fs, lik
 def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: float = 10.0,
             severity: float = 1.0, snr_db: float = 20.0, bearing=None, gear_teeth: int = 32,
             resonance_hz: float = 3500.0, cage_modulation: float = 0.0, shaft_impacts: float = 0.0,
-            mesh: float = 0.0, tooth_error: float = 0.0, seed=None, unit: str = "g", tach: int = 0) -> Record:
+            mesh: float = 0.0, tooth_error: float = 0.0, mating_teeth: int = 0, seed=None, unit: str = "g", tach: int = 0) -> Record:
     """Accelerometer record of a rotating machine, healthy or with one fault, for tests and demos.
 
     Every machine has a small residual 1X and broadband noise. Faults: unbalance (strong 1X),
@@ -85,10 +85,13 @@ def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: f
         Amplitude (g) of a healthy gear mesh of ``gear_teeth`` x 1X: harmonics at 1/3 and 1/6 of it,
         +-1X sidebands at 8 % (eccentricity, runout), a 1 % wander of its amplitude.
     tooth_error : float
-        RMS of the gear's random tooth-to-tooth errors (pitch, profile, stiffness), relative, in the healthy
-        mesh and in a gear_mesh fault's: each
-        tooth modulates the mesh's amplitude by its error and its phase by twice it, as every real gear's
-        teeth do (AGMA and ISO 1328 accuracy grades bound them). 0 (default): identical teeth.
+        RMS of the gears' random tooth-to-tooth errors (pitch, profile, stiffness), relative, in the healthy
+        mesh and in a gear_mesh fault's: each tooth modulates the mesh's amplitude by its error and its
+        phase by twice it, as every real gear's teeth do (AGMA and ISO 1328 accuracy grades bound them).
+        0 (default): identical teeth.
+    mating_teeth : int
+        Teeth of the mating gear (0: none): its shaft turns at gear_teeth / mating_teeth of this one's; its
+        run-out (+-1 x its speed at 5 %) and tooth errors modulate the mesh too.
     seed : int, optional
         Random seed.
     unit : str
@@ -124,7 +127,11 @@ def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: f
     base = _residual_unbalance(shaft, rng)
     if not (np.isfinite(tooth_error) and 0 <= tooth_error <= 0.5):
         raise ParameterError(f"tooth_error={tooth_error!r} must be a relative RMS error in [0, 0.5]")
-    sig = severity * _fault_signal(fault, shaft, rng, b, gear_teeth, resonance_hz, tooth_error)
+    if isinstance(mating_teeth, bool) or not isinstance(mating_teeth, (int, np.integer)) or mating_teeth < 0 \
+            or 0 < mating_teeth < 5:
+        raise ParameterError(f"mating_teeth={mating_teeth!r} must be a whole number of teeth >= 5 (0: no mating gear)")
+    gear = (gear_teeth, tooth_error, int(mating_teeth))
+    sig = severity * _fault_signal(fault, shaft, rng, b, gear, resonance_hz)
     p_sig = np.mean(sig ** 2) if fault != "none" else np.mean((0.3 * np.ones(1)) ** 2) / 2
     noise = rng.normal(0, np.sqrt(p_sig / 10 ** (snr_db / 10)), shaft.n)
     noise = _cage_modulated(noise, cage_modulation, shaft, rng, b)
@@ -132,7 +139,7 @@ def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: f
     if mesh < 0 or not np.isfinite(mesh):
         raise ParameterError(f"mesh={mesh!r} must be an amplitude in g >= 0")
     if mesh:
-        sig = sig + mesh * _healthy_mesh(shaft, rng, gear_teeth, tooth_error)
+        sig = sig + mesh * _healthy_mesh(shaft, rng, *gear)
     return _machine_record(base + sig + noise, shaft, fault, severity, snr_db, unit, tach)
 
 
@@ -187,26 +194,32 @@ def _residual_unbalance(shaft: _Shaft, rng) -> np.ndarray:
     return 0.02 * (speed / 1797.0) * np.sin(shaft.phase(1) + rng.uniform(0, 2 * np.pi))
 
 
-def _healthy_mesh(shaft: _Shaft, rng, teeth: int, tooth_error: float = 0.0) -> np.ndarray:
+def _healthy_mesh(shaft: _Shaft, rng, teeth: int, tooth_error: float = 0.0, mating_teeth: int = 0) -> np.ndarray:
     """A healthy mesh of unit amplitude: teeth x 1X with its 2nd and 3rd harmonics, +-1X sidebands at
     8 % (a gear's eccentricity and runout), and a slow 1 % wander of its amplitude (the load). With
     ``tooth_error``, each tooth's random error (Gaussian, interpolated across the tooth) modulates the
-    amplitude by itself and the phase by twice itself: sidebands at every shaft order, none impulsive."""
+    amplitude by itself and the phase by twice itself: sidebands at every shaft order, none impulsive.
+    With ``mating_teeth``, the mating gear's run-out and tooth errors modulate it at its shaft's orders."""
     revs = shaft.theta if shaft.ramp else shaft.f1 * shaft.t
     am = 1 + 0.08 * np.cos(2 * np.pi * revs + rng.uniform(0, 2 * np.pi)) \
         + 0.01 * np.sin(2 * np.pi * 0.37 * shaft.t + rng.uniform(0, 2 * np.pi))
     pm = np.zeros_like(revs)
-    if tooth_error:
-        e = rng.normal(0.0, tooth_error, teeth)
-        x = (revs % 1.0) * teeth
-        i = np.floor(x).astype(int) % teeth
-        err = e[i] + (e[(i + 1) % teeth] - e[i]) * (x - np.floor(x))
-        am, pm = am + err, 2 * err
+    gears = [(teeth, revs)]
+    if mating_teeth:
+        revs2 = revs * teeth / mating_teeth
+        am = am + 0.05 * np.cos(2 * np.pi * revs2 + rng.uniform(0, 2 * np.pi))
+        gears.append((mating_teeth, revs2))
+    for z, turns in gears if tooth_error else ():
+        e = rng.normal(0.0, tooth_error, z)
+        x = (turns % 1.0) * z
+        i = np.floor(x).astype(int) % z
+        err = e[i] + (e[(i + 1) % z] - e[i]) * (x - np.floor(x))
+        am, pm = am + err, pm + 2 * err
     return am * sum(a * np.sin(2 * np.pi * k * teeth * revs + k * pm + rng.uniform(0, 2 * np.pi))
                     for k, a in ((1, 1.0), (2, 1 / 3), (3, 1 / 6)))
 
 
-def _fault_signal(fault, shaft: _Shaft, rng, b, gear_teeth, resonance_hz, tooth_error=0.0) -> np.ndarray:
+def _fault_signal(fault, shaft: _Shaft, rng, b, gear, resonance_hz) -> np.ndarray:
     """The fault's own vibration (before ``severity``), in g."""
     def ph():
         return rng.uniform(0, 2 * np.pi)
@@ -227,8 +240,8 @@ def _fault_signal(fault, shaft: _Shaft, rng, b, gear_teeth, resonance_hz, tooth_
         # of about 3 of the turn's gear_teeth meshes), the mesh force changes: a pulse on its amplitude
         revs = shaft.theta if shaft.ramp else shaft.f1 * shaft.t
         frac = (revs + rng.uniform()) % 1.0 - 0.5
-        pulse = np.exp(-0.5 * (frac * gear_teeth / 1.5) ** 2)
-        sig = 0.3 * (1 + pulse) * _healthy_mesh(shaft, rng, gear_teeth, tooth_error)
+        pulse = np.exp(-0.5 * (frac * gear[0] / 1.5) ** 2)
+        sig = 0.3 * (1 + pulse) * _healthy_mesh(shaft, rng, *gear)
     elif fault == "resonance":
         # a structural mode (zeta 0.04) 6 % above 1X: the running speed's force and the broadband
         # forces both come out amplified, the latter as a hump in the noise floor

@@ -9,7 +9,7 @@ import numpy as np
 from ...core.errors import ParameterError
 from .cage import _cage_floor
 from .decoys import _decoy_p, _speed_scan
-from .families import HALVES, _accepted, _claim_artefact, _explain, _shaft_shows
+from .families import HALVES, _accepted, _claim_artefact, _claim_shaft, _explain, _shaft_shows
 from .lines import _log_p_to_conf
 from .rules import ALPHA, FAMILIES, MIN_VOTES, R_LINE, SAME_DATA, SINGLE_VIEW_P, SLIP
 from .smeared import _call_smeared, _smeared_ball
@@ -53,7 +53,7 @@ class BearingEvidence:
 def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: int, *, band=None,
                      shaft_hz: float | None = None, f1_known: bool = True, whitening=("cepstral",),
                      artefact_hz=(), speed_search: float | None = None, speed_confirmed: bool | None = None,
-                     smeared_ball: bool = True) -> BearingEvidence:
+                     smeared_ball: bool = True, other_shafts_hz=()) -> BearingEvidence:
     """Evidence per bearing family over every channel of a record, as a statistical test.
 
     Parameters
@@ -87,6 +87,9 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
         Whether the speed is confirmed (default ``f1_known``).
     smeared_ball : bool
         Ask for the ball's smeared comb where no family passes; off where the speed varies unfollowed.
+    other_shafts_hz : tuple of float
+        Speeds (Hz) of the machine's other shafts (a gearbox's mating shaft): their harmonics are claimed
+        like this shaft's, so that a second shaft's comb is not taken for a bearing's.
 
     Returns
     -------
@@ -108,7 +111,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     True
     """
     spectra, measured = _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefact_hz,
-                                           shaft_hz or f1, f1_known)
+                                           shaft_hz or f1, f1_known, tuple(other_shafts_hz))
     fams, votes = _family_summaries(spectra, freqs)
     smeared = _smeared_if_none(fams, spectra, freqs, f1) if smeared_ball else None
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))
@@ -118,7 +121,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     return BearingEvidence(fams, spectra, kurtogram, len(spectra), measured, other, rival)
 
 
-def _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefact_hz, shaft_hz, f1_known):
+def _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefact_hz, shaft_hz, f1_known,
+                       other_shafts_hz=()):
     """Every channel's SES (cage floor divided out before the channels are fused), the fused views,
     and on each the lines explained by the shaft, artefacts, the cage and the families."""
     spectra, measured = [], {}
@@ -132,10 +136,14 @@ def _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefac
     # bearing line explains: a bearing whose fault line falls on a shaft harmonic (the 6203's 2 x BSF
     # is 3.987 X, one bin from 4X on a 4 s record) then keeps that line and its multiples
     shaft = any(_shaft_shows(s, shaft_hz, f1_known, freqs) for s in spectra)
+    # another shaft (its speed known from the gear ratio) claims its harmonics by the same rule
+    others = [(hz, any(_shaft_shows(s, hz, True, freqs) for s in spectra)) for hz in other_shafts_hz]
     spectra += _fused(spectra)
     for s in spectra:
         for g in artefact_hz:
             _claim_artefact(s, g)
+        for hz, shows in others:
+            _claim_shaft(s, hz, True, freqs, contested=shows)
         _explain(s, freqs, f1, shaft_hz, f1_known, n_balls, shaft=shaft)
     if not spectra:
         raise ParameterError(f"whitening={whitening!r} selects no pre-processing; choose from {WHITENING}")

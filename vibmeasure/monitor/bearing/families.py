@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .cage import _claim_cage
-from .lines import _comb, _line_present, _mask, _peak_at
+from .lines import _comb, _denser, _line_present, _mask, _peak_at
 from .rules import ALPHA, CONTESTED, FAMILIES, MODULATION, OWN_ORDERS, R_CAP, SLIP
 from .spectra import _SES
 
@@ -97,6 +97,9 @@ def _family(ses: _SES, name: str, freqs: dict, f1: float) -> dict | None:
     if best is not None:
         best["logp"] = min(0.0, best["logp"] + np.log(len(models)))
         best["modulation"] = _modulation(ses, name, freqs, f1)
+        # the shaft modulates every family's lines (+-1X); the cage a ball's (+-FTF)
+        best["denser"] = _denser(ses, freqs[key] * (1 + best["slip"]), best["spec"][0],
+                                 (f1, freqs["FTF"]) if name == "bearing_ball" else (f1,))
         car = _comb(ses, freqs[key], (1, 2, 3))
         vals = [ln["r"] for ln in car["lines"]] if car else [0.0]
         # who claims first: the family with more of its own first three harmonics standing out, then
@@ -170,10 +173,13 @@ def _accepted(res: dict | None) -> bool:
       fundamental (HALVES of them), the comb is the even part of one at half the fundamental: the
       speed declared twice too fast puts every line of the true comb at half a harmonic of the
       declared one. MFPT's outer race declared at 3000 rpm (true 1500) read as outer race at 1.00 from
-      BPFO x 2, 4, 6 ... of the true speed, with the odd ones standing between."""
+      BPFO x 2, 4, 6 ... of the true speed, with the odd ones standing between.
+    - Denser combs (``lines._denser``): with lines as high as its own standing at most of the places
+      j / m x the fundamental between its first three harmonics (m = 3 .. 12), the comb is every m-th
+      line of another comb (a second shaft's harmonics)."""
     return bool(res and res["n_lines"] >= 2 and res["n_carriers"] >= 1 and res["logp"] < np.log(ALPHA)
                 and res.get("step", 1.0) <= 1.0 and res.get("halves", 0) < HALVES
-                and res.get("modulation") != 0 and not res.get("edge"))
+                and res.get("modulation") != 0 and not res.get("edge") and not res.get("denser"))
 
 
 def _survives(ses: _SES, name: str, claimant: str, freqs: dict, f1: float) -> bool:

@@ -183,6 +183,48 @@ def _halves(ses: _SES, f0: float, harmonics, base: bool = False) -> int:
     return sum(height((h - 0.5) * f0) >= need for h in (1, 2, 3) if (h - 0.5) * f0 / df >= 2)
 
 
+DENSER_MAX = 12      # denser combs tried: f0 / 3 .. f0 / DENSER_MAX
+DENSER_SHARE = 0.5   # of the in-between places that stand as high as the comb's own lines
+
+
+def _denser(ses: _SES, f0: float, harmonics, own_sidebands=()) -> int:
+    """The m (3 .. DENSER_MAX) for which the comb is every m-th line of a comb at f0 / m: at least
+    DENSER_SHARE (and 3) of the places j f0 / m between its first three harmonics (j not a multiple of m)
+    hold lines as high as the comb's own (HALF_SHARE of the median of its standing harmonics 1-3); 0
+    when there is no such m. Places within 1.5 bins or 1 % of the comb's own modulation sidebands
+    (harmonics 1-3 +- 1, 2 x each spacing in ``own_sidebands``) are not asked: the 6203's BPFO is
+    3.05 X, so its +-1X sidebands stand at about j BPFO / 3. Another shaft's harmonics (a gearbox's second shaft, a belt's pulley) make
+    such a comb: a 32/71 gearbox at 1800 rpm has its wheel's 8th, 16th, 24th and 32nd orders 0.6 % off
+    a 6205's BPFO and its harmonics, with the seven lines between each standing too. (m = 2 is
+    ``_halves``.)"""
+    if any(h != int(h) for h in harmonics):
+        return 0
+    df, r = ses.freq[1], ses.r
+    top = ses.n_valid - 3
+
+    def heights(hz):
+        i = (np.asarray(hz) / df).astype(np.int64)
+        ok = (i >= 1) & (i < top)
+        i = np.where(ok, i, 1)
+        return np.where(ok, np.max(np.stack([r[i - 1], r[i], r[i + 1], r[i + 2]]), axis=0), 0.0)
+    own = heights(np.arange(1, 4) * f0)
+    own = own[own >= ses.r_line]
+    if not own.size:
+        return 0
+    need = max(ses.r_line, HALF_SHARE * float(np.median(own)))
+    mods = np.array([h * f0 + k * sp for h in (1, 2, 3) for sp in own_sidebands for k in (-2, -1, 1, 2)])
+    for m in range(3, DENSER_MAX + 1):
+        hz = np.array([j * f0 / m for j in range(1, 3 * m) if j % m and j * f0 / m / df >= 2])
+        if mods.size and hz.size:
+            hz = hz[np.all(np.abs(hz[:, None] - mods[None, :]) > np.maximum(1.5 * df, 0.01 * hz[:, None]), axis=1)]
+        if hz.size < 3:
+            continue
+        n = int(np.sum(heights(hz) >= need))
+        if n >= max(3, DENSER_SHARE * hz.size):
+            return m
+    return 0
+
+
 def _step(harmonics) -> float:
     """The spacing, in multiples of the fundamental, of the comb the standing lines' harmonics make: the
     greatest common divisor of their half-harmonic indices 2h, over 2 (1.0 when no line stands). Up to 1

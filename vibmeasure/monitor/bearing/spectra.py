@@ -127,9 +127,13 @@ def _candidates(x, fs, f1, freqs, band, whitening):
     if "cepstral" in whitening:
         kg = kurtogram_of(None, fs, n=x.size, min_bandwidth=min_bw, max_level=None, criterion="kurtosis",
                            cyclic_max=f_need, X=Xw, f_lo=f_lo, f_hi=f_hi)
-        out += [("cepstral", (f_lo, f_hi), Xw, kg), ("cepstral + kurtogram", kg.band, Xw, None)]
+        out.append(("cepstral", (f_lo, f_hi), Xw, kg))
+        # a measured band only about twice the narrowest width leaves the kurtogram no band to choose
+        # (NaN): the whole band stands alone
+        if _finite(kg.band):
+            out.append(("cepstral + kurtogram", kg.band, Xw, None))
         info = tuple(kg.best("negentropy")[:2])
-        if info != tuple(kg.band):
+        if _finite(info) and info != tuple(kg.band):
             out.append(("cepstral + infogram", info, Xw, None))
     if "ar" in whitening:
         y = edit_lines(x - synchronous_part(x, fs, f1))
@@ -137,8 +141,13 @@ def _candidates(x, fs, f1, freqs, band, whitening):
         Xa[k_hi + 1:] = 0
         kga = kurtogram_of(None, fs, n=x.size, min_bandwidth=min_bw, max_level=None, criterion="kurtosis",
                             cyclic_max=f_need, X=Xa, f_lo=f_lo, f_hi=f_hi)
-        out.append(("synchronous removed + AR + kurtogram", kga.band, Xa, kga if not out else None))
+        out.append(("synchronous removed + AR + kurtogram", kga.band, Xa, kga if not out else None) if _finite(kga.band)
+                   else ("synchronous removed + AR", (f_lo, f_hi), Xa, kga if not out else None))
     return out, f_hi
+
+
+def _finite(band) -> bool:
+    return bool(np.all(np.isfinite(np.asarray(band, float))))
 
 
 def _spectra(x: np.ndarray, fs: float, name: str, f1: float, freqs: dict, band,

@@ -32,7 +32,8 @@ def _bearing_rows(job: Job, f1: float, speed: dict):
     ev = bearing_evidence(job.signals, job.fs, f1, freqs, job.bearing.n_balls, band=job.band,
                           shaft_hz=shaft, f1_known=speed["estimated_rpm"] is not None, whitening=job.prewhitening,
                           artefact_hz=glitch, speed_search=SPEED_SEARCH, speed_confirmed=_confirmed(speed),
-                          smeared_ball=not ("speed_varies" in job.flags and "order_tracked" not in job.flags))
+                          smeared_ball=not ("speed_varies" in job.flags and "order_tracked" not in job.flags),
+                          other_shafts_hz=_other_shafts(job, shaft))
     rows = []
     for name, s in ev.families.items():
         lines = [f"{ln['hz']:.1f} Hz {ln['db']:.0f} dB" for ln in s["lines"] if ln["r"] >= 6.0]
@@ -63,6 +64,12 @@ def _bearing_rows(job: Job, f1: float, speed: dict):
                          not_called=s.get("not_called"),
                          harmonics=[{k: ln[k] for k in ("harmonic", "sideband", "hz", "db")} for ln in s["lines"]]))
     return rows, ev
+
+
+def _other_shafts(job: Job, shaft: float) -> tuple:
+    """The mating shaft's speed where a gear with its ratio is given (its harmonics are claimed)."""
+    gear = job.gear
+    return () if gear is None or gear.mating_shaft_ratio is None else (shaft * gear.mating_shaft_ratio,)
 
 
 CAGE_NOTE = "cage-rate modulation (FTF comb): common on healthy bearings; not a fault by itself, trend it"

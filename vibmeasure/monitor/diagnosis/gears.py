@@ -145,8 +145,8 @@ def _places(fm: float, spacing: float, top: float, shift: float = 0.0) -> np.nda
 
 def _count(A, df, fm, spacing, top, tol, ring) -> int:
     """Places around the mesh harmonics where a sideband stands (LINE_DB over its floor) and the same
-    place around the point halfway below the harmonic either holds none or one LINE_DB lower. A local
-    tooth fault's
+    place around the point halfway below the harmonic either holds none or one LINE_DB lower, less the
+    places where it is the other way round. A local tooth fault's
     pulse, a few teeth long, spreads sidebands a few orders wide: high near the mesh, low halfway. A
     shaft's own comb (impacts once a turn, a rub, looseness) and random tooth-to-tooth errors fill every
     order alike, near the mesh and halfway."""
@@ -156,7 +156,9 @@ def _count(A, df, fm, spacing, top, tol, ring) -> int:
     keep = (near > 0) & (near < top) & (half > 0) & (half < top)
     h_near = _heights(A, df, near[keep], tol, ring)
     h_half = _heights(A, df, half[keep], tol, ring)
-    return int(np.sum((h_near >= LINE_DB) & ((h_half < LINE_DB) | (h_near - h_half >= LINE_DB))))
+    near_only = (h_near >= LINE_DB) & ((h_half < LINE_DB) | (h_near - h_half >= LINE_DB))
+    half_only = (h_half >= LINE_DB) & ((h_near < LINE_DB) | (h_half - h_near >= LINE_DB))
+    return max(0, int(np.sum(near_only)) - int(np.sum(half_only)))
 
 
 def _decoys(f1: float, shafts: list) -> np.ndarray:
