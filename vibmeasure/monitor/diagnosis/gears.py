@@ -143,22 +143,39 @@ def _places(fm: float, spacing: float, top: float, shift: float = 0.0) -> np.nda
     return hz[(hz > 0) & (hz < top)]
 
 
-def _count(A, df, fm, spacing, top, tol, ring) -> int:
+def _count(A, df, fm, spacing, top, tol, ring, avoid=()) -> int:
     """Places around the mesh harmonics where a sideband stands (LINE_DB over its floor) and the same
     place around the point halfway below the harmonic either holds none or one LINE_DB lower, less the
     places where it is the other way round. A local tooth fault's
     pulse, a few teeth long, spreads sidebands a few orders wide: high near the mesh, low halfway. A
     shaft's own comb (impacts once a turn, a rub, looseness) and random tooth-to-tooth errors fill every
-    order alike, near the mesh and halfway."""
+    order alike, near the mesh and halfway. Places on a harmonic of a shaft in ``avoid`` are not asked
+    (the decoys avoid every shaft): the mesh is a whole order of every shaft it joins, so each shaft's
+    sidebands around it are simply that shaft's harmonics, and a 71-tooth wheel's random tooth errors
+    stand at most of them (decoy spacings counted up to 23 places, and a pinion's local fault with 8
+    did not beat them)."""
     offsets = np.array([s * n * spacing for k in MESH_HARMONICS for n in WIDE_SIDEBANDS for s in (-1, 1)])
     near = np.repeat(np.asarray(MESH_HARMONICS, float) * fm, 2 * len(WIDE_SIDEBANDS)) + offsets
     half = near - 0.5 * fm
     keep = (near > 0) & (near < top) & (half > 0) & (half < top)
+    for s in avoid:
+        for hz in (near, half):
+            keep &= np.abs(hz - np.rint(hz / s) * s) > (tol + 0.5) * df
     h_near = _heights(A, df, near[keep], tol, ring)
     h_half = _heights(A, df, half[keep], tol, ring)
     near_only = (h_near >= LINE_DB) & ((h_half < LINE_DB) | (h_near - h_half >= LINE_DB))
     half_only = (h_half >= LINE_DB) & ((h_near < LINE_DB) | (h_half - h_near >= LINE_DB))
     return max(0, int(np.sum(near_only)) - int(np.sum(half_only)))
+
+
+def _half_width(A: np.ndarray, i: int) -> int:
+    """Bins on either side of the peak at i down to half its amplitude (the wider side)."""
+    peak, lo, hi = A[i], i, i
+    while lo > 0 and A[lo - 1] > peak / 2:
+        lo -= 1
+    while hi < A.size - 1 and A[hi + 1] > peak / 2:
+        hi += 1
+    return max(i - lo, hi - i)
 
 
 def _decoys(f1: float, shafts: list) -> np.ndarray:
@@ -215,20 +232,25 @@ def gear_rows(run) -> list:
     if mesh_db < LINE_DB:
         return [_row("gear_mesh", fm, mesh_f, mesh_amp, mesh_db, 0.0,
                      f"no mesh line at {gear.teeth} x 1X ({fm:.1f} Hz): the gear is not seen")]
+    # the mesh line measures the speed: the places are set from it, as wide as the line itself is (a
+    # steady speed: a window's main lobe; a wandering one smears the line and its sidebands alike)
+    hz = _refine(f, A, mesh_f)
+    shafts = [(name, s * hz / fm) for name, s in shafts]
     spacing_min = min(s for _, s in shafts)
-    tol = max(2, int(round(0.002 * fm / df)))
+    tol = max(2, min(int(round(0.002 * fm / df)), _half_width(A, int(round(mesh_f / df))) + 1))
+    expected, fm = fm, hz
     ring = max(tol + 6, int(0.35 * 0.6 * spacing_min / df))   # inside the gap to the nearest decoy sideband
     top = f[-1] - ring * df
     # a shaft's own comb (impacts once a turn, a rub, looseness) stands at every order, around the mesh
     # and between its harmonics alike: only what stands around the mesh beyond what stands halfway
     # between (``shift`` -0.5) is the mesh's modulation. (Without this, a healthy machine with a rub
     # was called gear_mesh on 18 of 30 synthetic records.)
+    speeds = [s for _, s in shafts]
     counts = {name: _count(A, df, fm, s, top, tol, ring) for name, s in shafts}
-    decoy = np.array([_count(A, df, fm, u, top, tol, ring) for u in _decoys(f1, [s for _, s in shafts])])
+    decoy = np.array([_count(A, df, fm, u, top, tol, ring, speeds) for u in _decoys(f1, speeds)])
     # the average needs the shaft's speed to a small part of a turn over the record: the mesh line, many
     # orders up and refined between bins, measures it better than the 1X (0.1 % off smears a pulse over a
     # fifth of a turn in 180; a bin's width, 1/T, drifts order k by k / fm turns over the record)
-    hz = _refine(f, A, mesh_f)
     name, c, p, stands, (fm4, fm4_p) = _winner(run, shafts, counts, decoy, hz, fm)
     spacing = dict(shafts)[name]
     score = (1 - p) * min(1.0, c / (MIN_SIDEBANDS + 2)) if stands else 0.0
@@ -260,5 +282,5 @@ def gear_rows(run) -> list:
                  "fault makes it: random tooth errors, a distributed modulation (an eccentric or off-centre gear, "
                  "load changes) or a wandering speed")
         run.job.flags.append("gear_not_impulsive")
-    return [_row("gear_mesh", fm, mesh_f, mesh_amp, mesh_db, score, note, sidebands=c, decoy_p=p, fm4=fm4,
+    return [_row("gear_mesh", expected, mesh_f, mesh_amp, mesh_db, score, note, sidebands=c, decoy_p=p, fm4=fm4,
                  fm4_p=fm4_p, **per_shaft)]
