@@ -32,8 +32,9 @@ FLAG_ADVICE = {
     "not_impact": "use estimate_frf for shaker (continuous) excitation",
     "unit_doubtful": "check the channel's unit and quantity (an accelerometer's g or m/s^2 declared as mm/s?) and "
                      "analyse again",
-    "gear_not_impulsive": "inspect the gear for eccentricity or run-out; record with a tachometer (tach=) so the "
-                          "synchronous average is sharp, and trend FM4",
+    "gear_not_impulsive": "the gear's sidebands are those of random tooth errors, run-out or eccentricity, not of "
+                          "a local tooth fault: trend NA4 (vm.trend) to see a gear wear; record with a tachometer "
+                          "(tach=) so the synchronous average is sharp",
     "bearing_not_checked": "give the bearing (catalogue name or geometry) so bearing faults are searched",
     "band_limited": "record a wider band (sample faster, open the anti-alias filter): bearing impacts ring in "
                     "resonances well above the shaft harmonics",

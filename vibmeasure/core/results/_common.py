@@ -37,8 +37,9 @@ FLAG_TEXT = {
     "not_harmonic": "the motion is not one sinusoid (harmonics above 5 %): the equivalent viscous c assumes "
                     "harmonic motion and holds only as an energy equivalent",
     # machine diagnosis
-    "gear_not_impulsive": "the gear's wide sidebands stand, but its synchronous average is not impulsive (FM4 "
-                          "under 4) as a local tooth fault makes it: the gear call is held",
+    "gear_not_impulsive": "the gear's wide sidebands stand, but its synchronous residual is not impulsive as a "
+                          "local tooth fault makes it (FM4 under 4, no higher than random tooth errors of the same "
+                          "sideband spectrum give, or no average possible): the gear call is held or dropped",
     "unit_doubtful": "a channel declared velocity or displacement carries most of its power above 1 kHz, as an "
                      "acceleration does: the unit conversion, the levels and the ISO zone are in doubt",
     "bearing_not_checked": "no bearing given: bearing faults were not searched",

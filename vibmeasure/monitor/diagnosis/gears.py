@@ -1,10 +1,12 @@
-"""Step: the gear, as a statistical test like the bearings'. The null is a healthy mesh: a line at
-teeth x 1X with its harmonics and modest sidebands at +-1 x either shaft's speed (eccentricity, runout
-and the load's variation make them on every working gearbox). A local tooth fault (a crack, a broken or
-chipped tooth) strikes once a turn of its shaft: it modulates the mesh with a short pulse, whose
-spectrum spreads sidebands at +-2, 3, ... x that shaft's speed around every mesh harmonic. The test
-counts those wider sidebands of each shaft and asks how unusual the count is among decoy spacings
-that are no shaft's speed, on the same spectrum (``gear_rows``)."""
+"""Step: the gear, as a statistical test like the bearings'. The null is a healthy gearbox: a line at
+teeth x 1X with its harmonics, modest sidebands at +-1 x either shaft's speed (eccentricity, runout and
+the load's variation make them on every working gearbox), and each gear's random tooth-to-tooth errors,
+which modulate the mesh at every order of its shaft. A local tooth fault (a crack, a broken or chipped
+tooth) strikes once a turn of its shaft: it modulates the mesh with a short pulse, whose spectrum
+spreads sidebands at +-2, 3, ... x that shaft's speed around every mesh harmonic, in phase. The test
+counts those wider sidebands of each shaft against decoy spacings that are no shaft's speed, on the
+same spectrum, and asks the shaft's synchronous residual to be more impulsive than residuals of the
+same sideband spectrum with random timing (``gear_rows``)."""
 
 from __future__ import annotations
 
@@ -20,10 +22,11 @@ MIN_SIDEBANDS = 6
 N_DECOYS = 60
 DECOY_P = 0.05          # the shaft's count must beat this share of decoy spacings (1/61 at best)
 # FM4 (Stewart 1977): kurtosis of the time-synchronous average with the regular mesh removed (orders
-# 0-2, each mesh harmonic and its +-1 sidebands). A healthy mesh leaves near-Gaussian residue (3: 2.7-4.0
-# on synthetic healthy gearboxes); a local tooth fault's once-a-turn pulse makes it impulsive (7.4-9.6 on
-# synthetic ones). Sidebands that stand without it are a distributed modulation (run-out with harmonics,
-# an off-centre gear: 3.1-3.5 with +-2, 3 x 1X sidebands) or a speed that wanders: the call is held.
+# 0-2, each mesh harmonic and its +-1 sidebands). Identical teeth leave near-Gaussian residue (2.7-4.0 on
+# synthetic healthy gearboxes); a local tooth fault's once-a-turn pulse makes it impulsive (6-10 on
+# synthetic ones); random tooth errors of 2-10 % read 4-8 (a modulated carrier is no Gaussian), hence
+# the surrogate test below. Sidebands that stand without both are a distributed modulation (tooth
+# errors, run-out with harmonics, an off-centre gear) or a speed that wanders.
 FM4_FAULT = 4.0
 MIN_REVOLUTIONS = 10    # revolutions the synchronous average needs
 # FM4 must also beat residuals of the same sideband spectrum with random timing (``impulsiveness``):
@@ -188,7 +191,7 @@ def _decoys(f1: float, shafts: list) -> np.ndarray:
     return u[:: max(1, u.size // N_DECOYS)][:N_DECOYS]
 
 
-def _winner(run, shafts: list, counts: dict, decoy: np.ndarray, hz: float, fm: float):
+def _winner(run, shafts: list, counts: dict, decoy: np.ndarray, fm: float):
     """(shaft, its count, decoy p, whether its sidebands stand, (FM4, p) of its residual). A shaft whose
     wide sidebands stand against the decoys and whose synchronous residual is impulsive (FM4 >= FM4_FAULT
     and p <= IMPULSE_P) is the faulty gear's; else the shaft with more sidebands, standing only when it
@@ -200,7 +203,7 @@ def _winner(run, shafts: list, counts: dict, decoy: np.ndarray, hz: float, fm: f
         c = counts[name]
         p = float((1 + np.sum(decoy >= c)) / (1 + decoy.size))
         tests[name] = (c, p, c >= MIN_SIDEBANDS and p <= DECOY_P,
-                       impulsiveness(run.job.a, run.job.fs, hz * s / fm, fm / s) or (None, None))
+                       impulsiveness(run.job.a, run.job.fs, s, fm / s) or (None, None))
     local = [n for n, (c, p, ok, (k, kp)) in tests.items() if ok and k is not None and k >= FM4_FAULT
              and kp <= IMPULSE_P]
     if local:
@@ -216,7 +219,7 @@ def gear_rows(run) -> list:
     """The gear row where a gear is given: the mesh line, and a fault where one shaft's wide sidebands
     (+-2..6 x its speed around mesh harmonics 1-3, less those standing halfway between the harmonics)
     stand in at least MIN_SIDEBANDS places, more often than at all but DECOY_P of the decoy spacings,
-    and more than the mating shaft's (``Gear.mating_shaft_ratio``).
+    and its synchronous residual is impulsive (``_winner``: FM4 and its surrogates).
     Reason: the test asked only for a mesh line with one +-1X sideband, which every working gearbox has:
     on real healthy gearboxes it called gear_mesh at up to 1.00."""
     gear = run.job.gear
@@ -243,15 +246,15 @@ def gear_rows(run) -> list:
     top = f[-1] - ring * df
     # a shaft's own comb (impacts once a turn, a rub, looseness) stands at every order, around the mesh
     # and between its harmonics alike: only what stands around the mesh beyond what stands halfway
-    # between (``shift`` -0.5) is the mesh's modulation. (Without this, a healthy machine with a rub
-    # was called gear_mesh on 18 of 30 synthetic records.)
+    # between is the mesh's modulation (``_count``; without it, a healthy machine with a rub was called
+    # gear_mesh on 18 of 30 synthetic records)
     speeds = [s for _, s in shafts]
     counts = {name: _count(A, df, fm, s, top, tol, ring) for name, s in shafts}
     decoy = np.array([_count(A, df, fm, u, top, tol, ring, speeds) for u in _decoys(f1, speeds)])
     # the average needs the shaft's speed to a small part of a turn over the record: the mesh line, many
     # orders up and refined between bins, measures it better than the 1X (0.1 % off smears a pulse over a
     # fifth of a turn in 180; a bin's width, 1/T, drifts order k by k / fm turns over the record)
-    name, c, p, stands, (fm4, fm4_p) = _winner(run, shafts, counts, decoy, hz, fm)
+    name, c, p, stands, (fm4, fm4_p) = _winner(run, shafts, counts, decoy, fm)
     spacing = dict(shafts)[name]
     score = (1 - p) * min(1.0, c / (MIN_SIDEBANDS + 2)) if stands else 0.0
     places = len(_places(fm, spacing, top))
@@ -259,8 +262,8 @@ def gear_rows(run) -> list:
     # ``teeth``, the mating one teeth / ratio; the other shaft's synchronous part is taken out first
     per_shaft = {}
     for key, (n, s) in zip(("shaft", "mating"), shafts):
-        var_k, fm4_k = residual_moments(run.job.a, run.job.fs, hz * s / fm, fm / s,
-                                        [hz * o / fm for m, o in shafts if m != n]) or (None, None)
+        var_k, fm4_k = residual_moments(run.job.a, run.job.fs, s, fm / s,
+                                        [o for m, o in shafts if m != n]) or (None, None)
         per_shaft.update({f"{key}_fm4": fm4_k, f"{key}_residual_var": var_k})
     note = (f"mesh {gear.teeth} x 1X at {mesh_db:.0f} dB; wide sidebands (+-2..6 x {name}'s {spacing:.2f} Hz) stand "
             f"in {c} of {places} places more than halfway between the mesh harmonics, decoy spacings p = {p:.2g}"
