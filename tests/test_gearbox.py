@@ -64,8 +64,8 @@ def test_the_declared_mating_shafts_harmonics_are_claimed():
     """A healthy 19/61 gearbox at 1200 rpm: the wheel's orders 15 and 30 (93.4, 186.8 Hz) stand where
     the 6205's 2 x BSF and its double fall (-0.9 % slip), and ball was called at 1.00, also with the
     gear's ratio declared. The mating shaft's speed (Gear.mating_shaft_ratio) now claims its harmonics
-    in the envelope spectra as the shaft's own do. Without the ratio the call remains (a noticed limit:
-    two lines of a random-amplitude comb, too few for the denser-comb rule)."""
+    in the envelope spectra as the shaft's own do. (Without the ratio, the two-view rule holds it: the
+    next test.)"""
     warnings.simplefilter("ignore", vm.QualityWarning)
     rec = _healthy_two_gear(1200, 19, 61, 0.05, 30, 0)
     d = vm.diagnose(rec, rpm=1200, bearing="6205-2RS", gear=vm.Gear(19, mating_shaft_ratio=19 / 61))
@@ -97,3 +97,15 @@ def test_a_measured_band_too_narrow_for_the_kurtogram_is_demodulated_whole():
     assert cands and all(np.all(np.isfinite(band)) for _, band, _, _ in cands)
     d = vm.diagnose(rec, rpm=1200, bearing="6205-2RS", prewhitening=("ar",))
     assert "band_limited" in d.flags
+
+
+def test_a_record_that_offers_one_view_gets_no_waiver_of_the_two_view_rule():
+    """The same band-limited gearbox, now searched in its one whole band: the wheel's orders 15 and 30
+    (93.4, 186.8 Hz) stand where the 6205's 2 x BSF and its double fall, p = 1e-8, and were called ball at
+    1.00 with or without the gear's teeth: a record with one view was waived the two-view rule. Now the
+    one view needs p below SINGLE_VIEW_P like any other."""
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    for error in (0.05, 0.1):
+        d = vm.diagnose(_healthy_two_gear(1200, 19, 61, error, 30, 0), rpm=1200, bearing="6205-2RS", gear=19)
+        ball = d.faults.set_index("fault").loc["bearing_ball"]
+        assert not _bearing_call(d) and ball.p_value < 1e-6 and "one view of the record only" in ball.not_called
