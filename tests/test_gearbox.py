@@ -60,15 +60,16 @@ def test_a_second_shafts_comb_is_not_taken_for_a_bearings(case):
     assert not _bearing_call(d), d.reason
 
 
-def test_the_declared_mating_shafts_harmonics_are_claimed():
-    """A healthy 19/61 gearbox at 1200 rpm: the wheel's orders 15 and 30 (93.4, 186.8 Hz) stand where
-    the 6205's 2 x BSF and its double fall (-0.9 % slip), and ball was called at 1.00, also with the
-    gear's ratio declared. The mating shaft's speed (Gear.mating_shaft_ratio) now claims its harmonics
-    in the envelope spectra as the shaft's own do. (Without the ratio, the two-view rule holds it: the
-    next test.)"""
+@pytest.mark.parametrize("case", [(1800, 32, 71, 0.05, 30, 2), (1000, 29, 53, 0.1, 30, 1)])
+def test_the_declared_mating_shafts_harmonics_are_claimed(case):
+    """Healthy two-gear gearboxes whose wheel orders fall on a bearing's comb: with the gear's ratio
+    declared they were called outer race at 0.87 (32/71 at 1800 rpm) and inner race at 1.00 (29/53 at
+    1000 rpm). The mating shaft's speed (Gear.mating_shaft_ratio) now claims its harmonics in the
+    envelope spectra as the shaft's own do."""
     warnings.simplefilter("ignore", vm.QualityWarning)
-    rec = _healthy_two_gear(1200, 19, 61, 0.05, 30, 0)
-    d = vm.diagnose(rec, rpm=1200, bearing="6205-2RS", gear=vm.Gear(19, mating_shaft_ratio=19 / 61))
+    rpm, teeth, mating = case[:3]
+    d = vm.diagnose(_healthy_two_gear(*case), rpm=rpm, bearing="6205-2RS",
+                    gear=vm.Gear(teeth, mating_shaft_ratio=teeth / mating))
     assert not _bearing_call(d), d.reason
 
 
@@ -99,13 +100,16 @@ def test_a_measured_band_too_narrow_for_the_kurtogram_is_demodulated_whole():
     assert "band_limited" in d.flags
 
 
-def test_a_record_that_offers_one_view_gets_no_waiver_of_the_two_view_rule():
-    """The same band-limited gearbox, now searched in its one whole band: the wheel's orders 15 and 30
-    (93.4, 186.8 Hz) stand where the 6205's 2 x BSF and its double fall, p = 1e-8, and were called ball at
-    1.00 with or without the gear's teeth: a record with one view was waived the two-view rule. Now the
-    one view needs p below SINGLE_VIEW_P like any other."""
+def test_a_band_limited_gearboxs_wheel_orders_are_not_a_ball_fault():
+    """The same band-limited gearbox, searched in its one whole band: the wheel's orders 15 and 30 (93.4,
+    186.8 Hz) stand where the 6205's 2 x BSF and its double fall, p = 1e-8 to 5e-10, and were called ball
+    at 1.00 with or without the gear's teeth. Two rules now hold it, each alone (checked by turning the
+    other off): the wheel's other orders stand between them as high (a comb one in every 3 or 5 lines
+    of a denser one), and a record that offers one view only gets no waiver of the two-view rule
+    (``test_bearing_faults.py::test_overwhelming_evidence_in_one_view_is_called``)."""
     warnings.simplefilter("ignore", vm.QualityWarning)
     for error in (0.05, 0.1):
         d = vm.diagnose(_healthy_two_gear(1200, 19, 61, error, 30, 0), rpm=1200, bearing="6205-2RS", gear=19)
         ball = d.faults.set_index("fault").loc["bearing_ball"]
-        assert not _bearing_call(d) and ball.p_value < 1e-6 and "one view of the record only" in ball.not_called
+        assert not _bearing_call(d) and ball.p_value < 1e-6, d.reason
+        assert "of a denser comb" in ball.not_called or "one view of the record only" in ball.not_called

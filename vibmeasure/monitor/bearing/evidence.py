@@ -284,6 +284,10 @@ def _not_called(name: str, fam: dict, n_sp: int, n_views: int) -> str | None:
                    f"half its fundamental ({fam['found_hz'] / 2:.1f} Hz), no frequency of this bearing at the "
                    f"declared speed; at half that speed it is this family's own (check the speed for a factor 2: "
                    f"rpm for Hz, pulses per revolution)")
+    if fam.get("denser"):
+        why.append(f"its lines are one in every {fam['denser']} of a denser comb at "
+                   f"{fam['found_hz'] / fam['denser']:.2f} Hz whose lines between stand as high: another shaft's "
+                   "harmonics (a gearbox's other shaft, a belt's pulley), no frequency of this bearing")
     if fam.get("edge"):
         why.append(f"its comb fits best at the edge of the +-{100 * SLIP:g} % slip range, so it would fit better "
                    "further off: the lines are not where this bearing puts them (a shaft-order comb, another "
@@ -326,6 +330,7 @@ def _summary(name, key, res, ses, freqs, n_sp) -> dict:
             "log10_p": float(logp / np.log(10)), "slip": res["slip"], "found_hz": float(f0),
             "lines": lines, "n_lines": res["n_lines"], "n_carriers": res["n_carriers"], "edge": res.get("edge", False),
             "n_odd": res.get("n_odd", 1), "step": res.get("step", 1.0), "halves": res.get("halves", 0),
+            "denser": res.get("denser", 0),
             "channel": ses.channel,
             "preprocessing": ses.prep,
             "band_hz": ses.band, "model": res.get("model"), "modulation_sidebands": res.get("modulation"),

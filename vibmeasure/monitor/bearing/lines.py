@@ -184,7 +184,7 @@ def _halves(ses: _SES, f0: float, harmonics, base: bool = False) -> int:
 
 
 DENSER_MAX = 12      # denser combs tried: f0 / 3 .. f0 / DENSER_MAX
-DENSER_SHARE = 0.5   # of the in-between places that stand as high as the comb's own lines
+DENSER_SHARE = 1 / 3   # of the in-between places that stand as high as the comb's own lines
 
 
 def _denser(ses: _SES, f0: float, harmonics, own_sidebands=()) -> int:
