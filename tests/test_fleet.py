@@ -476,9 +476,12 @@ def test_cli_batch_fails_when_every_input_failed_and_ctrl_c_is_one_line(tmp_path
     # the signal then sometimes came as the batch ended
     for i in range(40):
         vm.write(folder / f"r{i:02d}.h5", vm.synth.machine(rpm=1500.0, fs=12800.0, duration=30.0, seed=i))
+    # as from a terminal: a shell without job control starts background commands with SIGINT ignored,
+    # and the child would inherit that (CI launched with `&` failed here with exit 0)
     proc = subprocess.Popen([sys.executable, "-m", "vibmeasure", "batch", str(folder), "--store",
                              str(tmp_path / "big.db"), "--task", "diagnose"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 60
     while not (tmp_path / "big.db").exists() and time.monotonic() < deadline:   # the batch has begun
         time.sleep(0.2)
