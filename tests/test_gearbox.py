@@ -53,7 +53,7 @@ def test_a_healthy_two_gear_gearbox_is_no_gear_fault(case):
     wide sidebands stand (25-30 of 30 places, beyond every decoy) and FM4 reads 4.8-7.0, so the sideband
     and FM4 rules called gear_mesh on them (125 of the 180 healthy diagnoses with a gear declared in
     benchmarks/gearbox.py with the surrogate test turned off; 2 with it). The residual is no more
-    impulsive than the surrogates of its own spectrum (p 0.085-0.51): no gear fault."""
+    impulsive than the surrogates of its own spectrum (p 0.10-0.51): no gear fault."""
     warnings.simplefilter("ignore", vm.QualityWarning)
     rpm, teeth, mating, error = case
     rec = vm.synth.machine(fault="none", rpm=rpm, mesh=1.0, gear_teeth=teeth, mating_teeth=mating,
