@@ -33,8 +33,12 @@ def test_random_tooth_errors_are_a_healthy_gear_and_a_local_fault_still_shows_th
         frow = fault.faults.set_index("fault").loc["gear_mesh"]
         assert fault.top == "gear_mesh" and frow.fm4_p <= 0.005 and frow.sidebands >= 6, (error, frow.note)
     assert max(fm4) > 4.0   # FM4's threshold alone would not hold these healthy gears
-    with pytest.raises(vm.ParameterError, match="tooth_error"):
-        vm.synth.machine(mesh=1.0, tooth_error=-0.1)
+    for bad in (-0.1, 0.6, float("nan"), "5 %"):
+        with pytest.raises(vm.ParameterError, match="tooth_error"):
+            vm.synth.machine(mesh=1.0, tooth_error=bad)
+    for bad in (3, 2.5, True):
+        with pytest.raises(vm.ParameterError, match="mating_teeth"):
+            vm.synth.machine(mesh=1.0, mating_teeth=bad)
 
 
 

@@ -125,7 +125,8 @@ def machine(*, fault: str = "none", rpm=1797.0, fs: float = 12000.0, duration: f
     rng = np.random.default_rng(seed)
     b = bearing if isinstance(bearing, Bearing) else BEARINGS["6205-2RS"] if bearing is None else BEARINGS[bearing]
     base = _residual_unbalance(shaft, rng)
-    if not (np.isfinite(tooth_error) and 0 <= tooth_error <= 0.5):
+    if isinstance(tooth_error, bool) or not isinstance(tooth_error, (int, float, np.number)) \
+            or not (np.isfinite(tooth_error) and 0 <= tooth_error <= 0.5):
         raise ParameterError(f"tooth_error={tooth_error!r} must be a relative RMS error in [0, 0.5]")
     if isinstance(mating_teeth, bool) or not isinstance(mating_teeth, (int, np.integer)) or mating_teeth < 0 \
             or 0 < mating_teeth < 5:
