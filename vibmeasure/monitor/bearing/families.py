@@ -174,9 +174,10 @@ def _accepted(res: dict | None) -> bool:
       speed declared twice too fast puts every line of the true comb at half a harmonic of the
       declared one. MFPT's outer race declared at 3000 rpm (true 1500) read as outer race at 1.00 from
       BPFO x 2, 4, 6 ... of the true speed, with the odd ones standing between.
-    - Denser combs (``lines._denser``): with lines as high as its own standing at most of the places
-      j / m x the fundamental between its first three harmonics (m = 3 .. 12), the comb is every m-th
-      line of another comb (a second shaft's harmonics)."""
+    - Denser combs (``lines._denser``): with lines as high as its own standing at a third or more of
+      the places j / m x the fundamental between its first three harmonics (m = 3 .. 12, its own
+      modulation sidebands aside), the comb is every m-th line of another comb (a second shaft's
+      harmonics)."""
     return bool(res and res["n_lines"] >= 2 and res["n_carriers"] >= 1 and res["logp"] < np.log(ALPHA)
                 and res.get("step", 1.0) <= 1.0 and res.get("halves", 0) < HALVES
                 and res.get("modulation") != 0 and not res.get("edge") and not res.get("denser"))

@@ -193,10 +193,10 @@ def _denser(ses: _SES, f0: float, harmonics, own_sidebands=()) -> int:
     hold lines as high as the comb's own (HALF_SHARE of the median of its standing harmonics 1-3); 0
     when there is no such m. Places within 1.5 bins or 1 % of the comb's own modulation sidebands
     (harmonics 1-3 +- 1, 2 x each spacing in ``own_sidebands``) are not asked: the 6203's BPFO is
-    3.05 X, so its +-1X sidebands stand at about j BPFO / 3. Another shaft's harmonics (a gearbox's second shaft, a belt's pulley) make
-    such a comb: a 32/71 gearbox at 1800 rpm has its wheel's 8th, 16th, 24th and 32nd orders 0.6 % off
-    a 6205's BPFO and its harmonics, with the seven lines between each standing too. (m = 2 is
-    ``_halves``.)"""
+    3.05 X, so its +-1X sidebands stand at about j BPFO / 3. Another shaft's harmonics (a gearbox's
+    second shaft, a belt's pulley) make such a comb: a 32/71 gearbox at 1800 rpm has its wheel's 8th,
+    16th, 24th and 32nd orders 0.6 % off a 6205's BPFO and its harmonics, with lines between standing
+    too. (m = 2 is ``_halves``.)"""
     if any(h != int(h) for h in harmonics):
         return 0
     df, r = ses.freq[1], ses.r
