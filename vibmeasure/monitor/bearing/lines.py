@@ -141,13 +141,13 @@ def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
     if fit is None:
         return None
     harmonics, s, pos, terms, vals, T, j, logp = fit
-    n_s = s.size
+    n_s, df = s.size, ses.freq[1]
     best = vals[j].tolist()
     standing = [v >= ses.r_line for v in best]
     lines = [{"harmonic": float(h), "sideband": int(k), "hz": float(p), "r": v}
              for (h, k), p, v in zip(terms, pos[j].tolist(), best)]
     return {"logp": float(min(logp, 0.0)), "slip": float(s[j]), "stat": float(T[j]), "n_terms": len(terms),
-            "edge": bool(j in (0, n_s - 1) and T[j] > T[n_s // 2]),
+            "edge": bool((slip - abs(s[j])) * float(np.max(pos[j])) < df and T[j] > T[n_s // 2]),
             "strength": float(np.sum([v for (h, k), v in zip(terms, vals[j]) if k == 0])),
             "lines": lines, "n_lines": int(sum(standing)),
             "n_carriers": int(sum(bool(st and k == 0 and h <= 3) for (h, k), st in zip(terms, standing))),
