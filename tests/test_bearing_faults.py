@@ -101,6 +101,29 @@ def test_the_decoys_combs_scored_in_one_array_are_each_combs_own(rng):
         assert many == alone
 
 
+def test_a_comb_within_a_bin_of_the_slip_range_edge_is_at_the_edge(rng):
+    # each line is read over two bins, so a comb whose best slip lies less than one bin (at its top
+    # line) inside the range reads the lines a comb at the edge reads: it cannot be told from one
+    # further off. Sharp lines (skirts e-fold in 1.5 bins) 0.3 bin inside the edge are at the edge (on
+    # the + side the best slip is two grid points inside, 0.98 bin: the grid's last point alone would
+    # miss it); 3 bins inside they are not
+    f0, df = 107.36, 0.1
+    bin_top = df / (3 * f0)                      # one bin at the 3rd harmonic, as a slip
+    for inside, edge in ((0.3, True), (3.0, False)):
+        for sign in (-1, 1):
+            slip = sign * (bf.SLIP - inside * bin_top)
+            r = rng.exponential(size=8000)
+            for h in (1, 2, 3):
+                x = h * f0 * (1 + slip) / df
+                i = np.arange(int(x) - 15, int(x) + 16)
+                r[i] = np.maximum(r[i], 40.0 * np.exp(-np.abs(i - x) / 1.5))
+            res = bf._comb(_ses(r, df), f0, (1, 2, 3))
+            assert res["edge"] is edge, slip
+            assert bf._accepted(res) is not edge
+            if edge and sign > 0:
+                assert res["slip"] < bf.SLIP
+
+
 def test_a_comb_that_fits_best_at_the_edge_of_the_slip_range_is_not_called(rng):
     # a comb of broad lines (skirts falling e-fold in 20 bins, as a line smeared by speed changes)
     # 1.3 % from BPFO peaks inside the +-2 % range; placed 2.5 % off, its best slip is the range's edge

@@ -94,6 +94,22 @@ def test_the_declared_mating_shafts_harmonics_are_claimed(case):
     assert not _bearing_call(d), d.reason
 
 
+@pytest.mark.parametrize("case", [(1797, 32, 71, 0.1, 30, 2, True), (2400, 23, 67, 0.05, 30, 2, False)])
+def test_a_two_shaft_comb_that_fits_a_bearing_only_at_the_slip_edge_is_not_called(case):
+    """Lines of the two shafts' orders combined (129.0, 317.9, 506.8 Hz: 14 x 13.50 Hz apart, 2 x 29.95 Hz
+    below) fit the 6205's BPFI +-1X at -1.98 % slip, one grid point (half a bin) inside the +-2 % range;
+    on the 23/67 gearbox, 192.2 and 288.3 Hz fit 2 x BSF x 1, 1.5 at +1.94 %. A placement less than a bin
+    from the edge reads the lines the edge placement reads, so the comb would fit as well further off:
+    these were called inner race at 0.67 and ball at 1.00."""
+    warnings.simplefilter("ignore", vm.QualityWarning)
+    rpm, teeth, mating, error, snr, seed, ratio = case
+    gear = vm.Gear(teeth, mating_shaft_ratio=teeth / mating) if ratio else None
+    d = vm.diagnose(_healthy_two_gear(*case[:6]), rpm=rpm, bearing="6205-2RS", gear=gear)
+    assert not _bearing_call(d), d.reason
+    fault = "bearing_inner_race" if ratio else "bearing_ball"
+    assert "edge of the +-2 % slip range" in d.faults.set_index("fault").loc[fault, "not_called"]
+
+
 @pytest.mark.parametrize("fault", ["bearing_outer_race", "bearing_inner_race", "bearing_ball"])
 def test_bearing_faults_in_a_two_gear_gearbox_are_still_named(fault):
     """The claims above take lines from the bearing test: a bearing fault under a 0.5 g two-gear mesh

@@ -150,7 +150,10 @@ def _accepted(res: dict | None) -> bool:
     fits best at -2 % or +2 % would fit better still further off, where no bearing line is. On 1 s
     pieces of the development records' single channels, 566 calls were made: the 562 right ones had
     slips within +-1.8 %; the only one at the edge was wrong (CWRU IR021_0's drive-end channel, piece 2:
-    3X, 9X and 15X taken for BPFO x 1, 3, 5 at -2.00 %; the 6203's BPFO is 3.053 X).
+    3X, 9X and 15X taken for BPFO x 1, 3, 5 at -2.00 %; the 6203's BPFO is 3.053 X). The edge is the
+    last bin at the comb's top line: each line is read over two bins, so a placement less than a bin
+    inside reads what the edge placement reads (a healthy 32/71 gearbox's two-shaft lines fit BPFI +-1X
+    at -1.98 %, half a bin inside, and were called inner race at 0.67).
 
     And its standing lines (carriers and sidebands, each at its harmonic) pin the family's own
     fundamental: they do not all stand at multiples of one of its harmonics (``_step`` at most 1; in the
