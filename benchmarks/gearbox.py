@@ -14,7 +14,8 @@ Sections (a 6205-2RS declared on every record, 6 s at 12 kHz):
 - bearing faults under a 0.5 g two-gear mesh with 5 % tooth errors: named with and without the ratio.
 - rubs (one impact a turn, 0.5 and 1 x the fault RMS) beside a 1 g mesh: gear calls.
 
-Targets (issue 46): no confident gear call on a healthy gearbox; no confident wrong bearing call.
+Targets (issue 46): no confident gear call on a healthy gearbox; no confident wrong bearing call. Also
+counted: answers flagged ``band_limited`` (none of these records went through a filter).
 ``--save FILE`` writes the records (npz) and their truths; ``--load FILE`` diagnoses saved records
 with whichever vibmeasure is imported (a previous release run from its own checkout).
 
@@ -98,6 +99,7 @@ def main(argv):
     t0 = time.perf_counter()
     tally = collections.defaultdict(collections.Counter)
     wrong = []
+    limited = collections.Counter()
     for section, label, x, rpm, z1, z2, truth in recs:
         gears = {"no gear": None, "teeth": z1, "teeth and ratio": vm.Gear(z1, mating_shaft_ratio=z1 / z2)}
         if section != "healthy":
@@ -111,11 +113,15 @@ def main(argv):
                 continue
             kind = _kind(d.top, d.confidence, truth)
             tally[(section, name)][kind] += 1
+            if "band_limited" in d.flags:   # a filter's stop band read where the record measures its band
+                limited[section] += 1
             if kind.startswith("confident") and "(right)" not in kind:
                 wrong.append(f"{section}, {label}, {name}: {d.top} {d.confidence:.2f}")
     print(f"{'section':<15}{'declared':<18}answers")
     for (section, name), c in tally.items():
         print(f"{section:<15}{name:<18}" + ", ".join(f"{k} {v}" for k, v in sorted(c.items())))
+    print("\nflagged band_limited (no filter on these records): "
+          + ", ".join(f"{sec} {limited[sec]}" for sec in dict.fromkeys(k[0] for k in tally)))
     print(f"\nconfident wrong answers: {len(wrong)}")
     for w in wrong:
         print("  " + w)
