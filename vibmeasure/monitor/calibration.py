@@ -7,14 +7,16 @@ wrong (a weak resonance at -10 dB) and fault calls scored 0.7-0.8 right half the
 
 The map from score to probability is learnt by isotonic regression (pool-adjacent-violators), one
 map per answer: each fault name; answers the calibration set never gives (electrical) use their
-group's pooled map ("shaft", "bearing"). A "none" with a bearing given has its score's two parts
-(shaft-order, bearing) mapped apart (NONE_SHAFT, NONE_BEARING) and multiplied. The maps are learnt
+group's pooled map ("shaft", "bearing"). A "none" with a bearing given has its score's parts
+(shaft-order, gear, bearing) mapped apart (NONE_SHAFT, NONE_GEAR, NONE_BEARING) and multiplied; with
+no gear declared the gear part is not looked for and left out. The maps are learnt
 once with the bearing given and once without it (prefix UNCHECKED: there a "none" also stands for
 every bearing fault it could not see). ``benchmarks/calibrate_diagnosis.py`` learns them on synthetic
 machines the benchmark does not use and writes ``data/diagnosis_calibration.csv``. Each map is
 monotone, so the answers keep their order; each pooled block's rate carries a Beta(1, 1) prior, so a
-block of a few answers never says 0 or 1. The probabilities hold for the calibration set's mix: nine
-kinds of machine in equal numbers (one healthy in nine) at SNR -10, 0 and 10 dB; the bearing part of a
+block of a few answers never says 0 or 1. The probabilities hold for the calibration set's mix: ten
+kinds of machine in equal numbers (the nine of the benchmark, one healthy among them, and a healthy
+two-gear gearbox with random tooth errors) at SNR -10, 0 and 10 dB; the bearing part of a
 "none" (NONE_BEARING) is learnt on those and on the same kinds at -15 dB, the edge of bearing-fault
 detection. At -10 dB and above the synthetic bearing faults always show, so a map learnt there alone
 had never seen a "none" left beside a bearing family's near miss and gave it 0.99 (CWRU fan-end B021_0
@@ -35,14 +37,16 @@ import numpy as np
 
 from ..core.errors import ParameterError, VibMeasureError
 
-__all__ = ["calibrated", "fit_isotonic", "UNCHECKED", "NONE_SHAFT", "NONE_BEARING"]
+__all__ = ["calibrated", "fit_isotonic", "UNCHECKED", "NONE_SHAFT", "NONE_GEAR", "NONE_BEARING"]
 
 UNCHECKED = "bearing not checked:"   # prefix of the maps learnt without a bearing (bearing faults unseen)
-# "none" with a bearing: its score's two parts (shaft-order, bearing) are mapped on their own, each to the
-# chance that no fault of its kind hides behind the answer, and the two multiplied. One map of their
-# product could not tell a healthy machine with a marginal bearing comb (p ~ 0.002) from a buried
-# resonance: both scored 0.75, and such answers were right 7 % of the time.
-NONE_SHAFT, NONE_BEARING = "none|shaft", "none|bearing"
+# "none" with a bearing: its score's parts (shaft-order, gear, bearing) are mapped on their own, each to
+# the chance that no fault of its kind hides behind the answer, and multiplied. One map of their product
+# could not tell a healthy machine with a marginal bearing comb (p ~ 0.002) from a buried resonance: both
+# scored 0.75, and such answers were right 7 % of the time. Nor can one map of shaft orders and gear:
+# a gear held at 0.45 (its residual between the surrogates' 95th and 99.5th percentiles) is common on a
+# healthy gearbox's random tooth errors, where a shaft-order score of 0.45 was a fault every time.
+NONE_SHAFT, NONE_GEAR, NONE_BEARING = "none|shaft", "none|gear", "none|bearing"
 TABLE = Path(__file__).resolve().parents[1] / "data" / "diagnosis_calibration.csv"
 
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..bearing import FAMILIES
 from ..bearing.lines import _log_p_to_conf
-from ..calibration import NONE_BEARING, NONE_SHAFT, UNCHECKED, calibrated
+from ..calibration import NONE_BEARING, NONE_GEAR, NONE_SHAFT, UNCHECKED, calibrated
 from .bearings import CAGE_NOTE
 from .shaft import SHAFT_FAULTS
 
@@ -49,12 +49,14 @@ def _decide(table, job: Job, weak: bool):
     TOP_CONFIDENCE or more, and "undetermined" (probably a fault that cannot be named) below it, both
     with the reason and the strongest candidates. The last item returned is the probability that the
     machine is healthy (``p_healthy``)."""
-    s_shaft, s_bear = _p_none(table)
+    s_shaft, s_gear, s_bear = _p_none(table)
     if job.bearing is not None and not weak:
         # each part mapped to the chance that no fault of its kind was missed
         p_healthy = calibrated(NONE_SHAFT, s_shaft, NONE_SHAFT) * calibrated(NONE_BEARING, s_bear, NONE_BEARING)
+        if s_gear is not None:
+            p_healthy *= calibrated(NONE_GEAR, s_gear, NONE_GEAR)
     else:   # no bearing, or no channel with a band to demodulate: the bearing side says little
-        p_healthy = calibrated(UNCHECKED + "none", s_shaft * s_bear, UNCHECKED + "none")
+        p_healthy = calibrated(UNCHECKED + "none", s_shaft * (s_gear or 1.0) * s_bear, UNCHECKED + "none")
     ranked = table.assign(_bearing=table.fault.isin(list(FAMILIES)))
     # a bearing family that passed its test outranks shaft-order scores: it is the specific finding
     ranked = ranked.sort_values(["_bearing", "confidence"], ascending=False)
@@ -95,7 +97,8 @@ def _decide(table, job: Job, weak: bool):
         if isinstance(b.get("not_called"), str):
             strongest += f" (not called: {b.not_called})"
     strongest += _cage_standing(table)
-    p_none = s_shaft * s_bear
+    p_none = s_shaft * (s_gear or 1.0) * s_bear
+    parts = {"shaft": s_shaft, "bearing": s_bear} | ({} if s_gear is None else {"gear": s_gear})
     top_score = (f"strongest candidate {cand.fault} at score {cand.confidence:.2f}" if cand.confidence >= 0.005
                  else "every family scored 0.00")
     # "none" only where the machine is more likely healthy than not: below, "none, confidence 0.1" would
@@ -106,8 +109,7 @@ def _decide(table, job: Job, weak: bool):
             f"undetermined: no fault named, yet the machine is healthy with probability only {p_healthy:.2f}")
     reason = (f"{said}; {why}{checked}" if "speed_contradicted" in job.flags else
               f"{said}; {why}; {top_score}{strongest}{checked}")
-    return (top, conf, reason, [], job.primary, ("none", p_none, {"shaft": s_shaft, "bearing": s_bear}),
-            p_healthy)
+    return (top, conf, reason, [], job.primary, ("none", p_none, parts), p_healthy)
 
 
 def candidates(table, n: int = 3) -> list[dict]:
@@ -141,17 +143,20 @@ def _cage_standing(table) -> str:
             f"in a longer or later record")
 
 
-def _p_none(table) -> tuple[float, float]:
-    """The raw score of "none" in two parts, (shaft-order, bearing): the product of 1 - score over the
-    shaft-order families, and over the bearing families of 1 - their posterior from the p-value. The
-    score of "none" is their product; each part is calibrated on its own (monitor/calibration.py)."""
-    sel = table[table.fault.isin(SHAFT_FAULTS)]
+def _p_none(table) -> tuple[float, float | None, float]:
+    """The raw score of "none" in three parts, (shaft-order, gear, bearing): the product of 1 - score
+    over the shaft-order families, 1 - the gear's score (None with no gear declared: no gear row), and
+    the product over the bearing families of 1 - their posterior from the p-value. The score of "none"
+    is their product; each part is calibrated on its own (monitor/calibration.py)."""
+    sel = table[table.fault.isin(SHAFT_FAULTS) & (table.fault != "gear_mesh")]
     # a pattern not called for want of the unit still speaks against "none" (_unweighed)
     shaft = (sel.pattern.fillna(sel.confidence) if "pattern" in sel else sel.confidence).to_numpy(float)
     s_shaft = float(np.prod(1 - shaft)) if shaft.size else 1.0
+    gear = table.confidence[table.fault == "gear_mesh"].to_numpy(float)
+    s_gear = float(1 - gear.max()) if gear.size else None
     bear = table[table.fault.isin(list(FAMILIES))]
     s_bear = 1.0
     if len(bear):
         c = _log_p_to_conf(bear.log10_p.to_numpy(float) * np.log(10))
         s_bear = float(np.prod(1 - c))
-    return s_shaft, s_bear
+    return s_shaft, s_gear, s_bear
