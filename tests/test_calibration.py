@@ -58,29 +58,33 @@ def test_shipped_maps_are_monotone_probabilities():
 
 def _shaft_and_bearing(d) -> float:
     """The shaft-order and bearing parts of a "none"'s probability, the gear's aside (its map says at most
-    0.87 with a gear declared: a local tooth fault at -10 dB leaves no trace, test below)."""
+    0.74 with a gear declared: the gear test can miss a local tooth fault, test below)."""
     parts = d.extras["score_parts"]
     return (calibrated("none|shaft", parts["shaft"], "none|shaft")
             * calibrated("none|bearing", parts["bearing"], "none|bearing"))
 
 
 def test_the_gear_part_of_a_none_says_what_the_gear_test_can_miss():
-    """The gear part of a "none" is mapped on its own. A local tooth fault at -10 dB leaves the gear test
-    nothing (FM4 3.4-5.1, 2-4 wide sidebands; 12 of 12 calibration seeds tried answered "none" with the
-    gear at score 0, and 151 of the calibration set's 1,142 "none" answers hid a gear fault): that
-    "none" was 1.00 and is now the share of such answers that were right, 0.87. A healthy two-gear gearbox whose random tooth errors hold the gear test at 0.45
-    (FM4 8.3, surrogate p 0.0175) was "undetermined, healthy with probability 0.01", the shaft-order
-    map having seen 0.45 only on faults; it is "none"."""
+    """The gear part of a "none" is mapped on its own, learnt also on two-gear gearboxes with random
+    tooth errors, healthy and with a local tooth fault. The gear test misses local faults: at -10 dB it
+    is left nothing (FM4 3.4-5.1, 2-4 wide sidebands; 12 of 12 calibration seeds tried answered "none"
+    with the gear at score 0), and on gears with 5-10 % tooth errors the fault's residual may be no more
+    impulsive than the surrogates. Of the calibration set's "none" answers with the gear at score 0,
+    74 % were right: that "none" was 1.00 (maps learnt before the surrogate test) and is 0.73 now. A
+    healthy gearbox whose tooth errors hold the gear test at 0.45 (FM4 8.3, surrogate p 0.0175) was
+    healthy "with probability 0.01", the shaft-order map having seen 0.45 on faults only; held gears
+    were healthy in 21 % of the calibration's, and it says so. With no gear declared there is no gear
+    part."""
     warnings.simplefilter("ignore", vm.QualityWarning)
     buried = vm.diagnose(vm.synth.machine(fault="gear_mesh", snr_db=-10, seed=90001, duration=6.0),
                          bearing="6205-2RS", gear=32)
     assert buried.top == "none" and buried.extras["score_parts"]["gear"] == 1.0
-    assert 0.8 < buried.confidence < 0.9
+    assert 0.65 < buried.confidence < 0.8
     held = vm.diagnose(vm.synth.machine(fault="none", rpm=1200, mesh=1.0, gear_teeth=19, mating_teeth=61,
                                         tooth_error=0.05, snr_db=30, seed=0, duration=6.0),
                        rpm=1200, bearing="6205-2RS", gear=vm.Gear(19, mating_shaft_ratio=19 / 61))
     assert held.faults.set_index("fault").loc["gear_mesh", "confidence"] == 0.45
-    assert held.top == "none" and held.p_healthy > 0.7
+    assert held.top == "undetermined" and 0.15 < held.p_healthy < 0.3
     no_gear = vm.diagnose(vm.synth.machine(fault="none", seed=90001, duration=6.0), bearing="6205-2RS")
     assert "gear" not in no_gear.extras["score_parts"] and no_gear.confidence > 0.95
 
@@ -98,7 +102,7 @@ def test_none_on_a_buried_resonance_is_not_confident(seed):
                     gear=32)
     assert d.top == "undetermined" and d.extras["score"] < 0.78 and d.p_healthy < 0.1
     assert d.confidence == pytest.approx(1 - d.p_healthy) and d.extras["candidates"]
-    assert h.top == "none" and h.extras["score"] > 0.9 and _shaft_and_bearing(h) > 0.95 and h.confidence > 0.85
+    assert h.top == "none" and h.extras["score"] > 0.9 and _shaft_and_bearing(h) > 0.95 and h.confidence > 0.7
     parts = d.extras["score_parts"]   # the gear declared: its part is mapped on its own
     assert parts["shaft"] * parts["gear"] * parts["bearing"] == pytest.approx(d.extras["score"])
     assert d.p_healthy == pytest.approx(calibrated("none|shaft", parts["shaft"], "none|shaft")
@@ -123,7 +127,7 @@ def test_without_a_bearing_a_none_is_weak_evidence_of_health():
     # not the 0.99 a map learnt only where bearing faults always show gave it
     parts = seen.extras["score_parts"]
     assert parts["shaft"] > 0.95 and 0.85 < parts["bearing"] < 0.95
-    assert 0.6 < seen.confidence < 0.85
+    assert 0.6 < _shaft_and_bearing(seen) < 0.85
 
 
 @pytest.mark.parametrize("fault, seed, low", [("bearing_ball", 85809, True), ("none", 85800, False),
@@ -143,7 +147,7 @@ def test_a_none_beside_a_near_miss_is_not_confident(fault, seed, low):
         assert parts["bearing"] < 0.9 and d.p_healthy < 0.7
         assert "strongest bearing candidate bearing_ball" in d.reason
     else:
-        assert parts["bearing"] > 0.96 and _shaft_and_bearing(d) > 0.95 and d.confidence > 0.85
+        assert parts["bearing"] > 0.96 and _shaft_and_bearing(d) > 0.95 and d.confidence > 0.7
 
 
 def test_a_none_on_real_ball_records_with_a_near_miss_is_not_confident(shared_data):
