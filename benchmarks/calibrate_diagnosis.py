@@ -9,8 +9,9 @@ buried resonance looks like unbalance, came out over-confident on the benchmark.
 
 Each machine is diagnosed with its bearing named and again without it (the maps of a diagnosis that
 could not check bearing faults); the machines at EDGE_SNRS (-15 dB) only with it, and only for the
-bearing part of a "none" (NONE_BEARING, see EDGE_SNRS below). N = 150 gives 9,450 diagnoses in about
-6 minutes on 2 cores and reproduces the shipped table exactly (every seed is fixed).
+bearing part of a "none" (NONE_BEARING, see EDGE_SNRS below); the two gearboxes only with it, and only
+for the gear part (NONE_GEAR, see FAULTS below). N = 150 gives 11,250 diagnoses in about
+7 minutes on 2 cores and reproduces the shipped table exactly (every seed is fixed).
 
     python benchmarks/calibrate_diagnosis.py [N]      (N seeds per machine kind and SNR; default 150)
 """
