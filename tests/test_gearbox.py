@@ -15,7 +15,7 @@ def test_random_tooth_errors_are_a_healthy_gear_and_a_local_fault_still_shows_th
     """Every real gear's teeth differ a little (pitch, profile, stiffness; ISO 1328 grades bound them).
     The errors modulate the mesh at every shaft order and the modulated carrier is not Gaussian: with
     2-10 % RMS errors (synth.machine(tooth_error=)), FM4 alone reads above its threshold of 4 on most of
-    these records (3.7-8.1 here, above 4 on 9 of 12), and wherever the wide sidebands also stood a
+    these records (3.7-8.1 here, above 4 on 10 of 12), and wherever the wide sidebands also stood a
     call would have been made. What holds them: residuals of the same sideband spectrum with random timing read as high (p
     > 0.005), and sidebands that stand halfway between the mesh harmonics as high as near them count
     for nothing. A local tooth fault on such a gear is more impulsive than all 399 surrogates and its

@@ -1090,7 +1090,7 @@ def test_gear_sidebands_without_an_impulsive_residual_are_held():
     Gaussian residue); a smooth modulation leaves it near 3: no gear call (flag gear_not_impulsive), the
     FM4 named in the row. With the speed refined from the mesh line the average is
     sharp and the run-out reads FM4 4.3, over the 4: what holds it is that residuals of the same sideband
-    spectrum with random timing read as high (p 0.39-0.45), while a tooth fault's beats all 399 of them."""
+    spectrum with random timing read as high (p 0.45-0.52), while a tooth fault's beats all 399 of them."""
     for seed in range(3):
         rec = vm.synth.machine(fault="none", seed=seed, duration=6.0)
         t = np.arange(rec.n_samples) / rec.fs
