@@ -74,11 +74,14 @@ def test_a_second_shafts_comb_is_not_taken_for_a_bearings(case):
     harmonics (13.5 Hz x 8 = 108.2 Hz at 1800 rpm), with the seven orders between each standing too. With
     no gear declared, these records were called inner race at 0.86 and outer race at 0.74. A comb that
     is every m-th line of a denser one (m 3..12, its own +-1X sidebands aside) is not called; the
-    genuine faults of the same gearbox still are (below)."""
+    genuine faults of the same gearbox still are (below). The refusal says how to have the other shaft's
+    harmonics claimed: declare it (``Gear(teeth, mating_shaft_ratio=)``)."""
     warnings.simplefilter("ignore", vm.QualityWarning)
     rpm, teeth, mating, error, snr, seed = case
     d = vm.diagnose(_healthy_two_gear(*case), rpm=rpm, bearing="6205-2RS")
     assert not _bearing_call(d), d.reason
+    outer = d.faults.set_index("fault").loc["bearing_outer_race", "not_called"]
+    assert "one in every 4 of a denser comb" in outer and "mating_shaft_ratio" in outer
 
 
 @pytest.mark.parametrize("case", [(1800, 32, 71, 0.05, 30, 2), (1000, 29, 53, 0.1, 30, 1)])

@@ -29,6 +29,12 @@ class _SES:
     r_base: np.ndarray | None = None
     shape: int = 1               # r is the mean of this many independent spectra (Gamma(shape)/shape)
     cage_floor: dict = field(default_factory=dict)   # multiple of n_balls x FTF -> (lo Hz, hi Hz, level)
+    parts: tuple = ()            # a fused view's channels, each with its own band: ((channel, band), ...)
+
+    @property
+    def sources(self) -> tuple:
+        """The data this spectrum is made of: ((channel, band), ...), one pair unless channels were fused."""
+        return self.parts or ((self.channel, self.band),)
 
     @property
     def r_line(self) -> float:
@@ -189,5 +195,5 @@ def _fused(spectra: list) -> list:
             for k, v in s.cage_floor.items():
                 floor[k] = max(floor.get(k, v), v, key=lambda t: t[2])
         out.append(_SES("+".join(s.channel for s in group), label, band, group[0].freq[:n], amp, r, nv,
-                        shape=len(group), cage_floor=floor))
+                        shape=len(group), cage_floor=floor, parts=tuple((s.channel, s.band) for s in group)))
     return out
