@@ -323,7 +323,8 @@ def _not_called(name: str, fam: dict, n_sp: int, n_views: int) -> str | None:
     elif not why and _one_view(fam, fam["views"], n_views):
         why.append(f"it shows in one view of the record only ({fam['votes']} of the {n_sp} spectra: "
                    f"{fam['preprocessing']} in {fam['channel']!r}); a call needs {MIN_VOTES} views (other "
-                   f"channels, or bands that share at most half), or p below {SINGLE_VIEW_P:g} in one")
+                   f"channels, or bands that share at most half; channels fused are the view of one that shows it "
+                   f"alone), or p below {SINGLE_VIEW_P:g} in one")
     return "; ".join(why) or None
 
 
