@@ -990,7 +990,10 @@ def test_a_declared_speed_the_file_contradicts_is_held(shared_data):
     settles which is right, is flagged speed_disagrees_file and held under 0.5 (the reason names both
     speeds); at the file's speed, or a nameplate speed within 1 % of it, nothing is flagged. CWRU
     OR007@6_0 (fan end) declared at twice its speed took a line 3.3 % off for its 1X and read as inner
-    race at 0.92: held the same way."""
+    race at 0.92: held the same way. Held, the ball was still named; the bearing test is now run again
+    at the file's speed, which finds the outer race (p ~ 1e-33): one fault at one speed, another at the
+    other, so none is named ("undetermined", the outer race its strongest candidate). OR007@6_0 at twice
+    its speed reads its own outer race at the file's speed too, and is not named either."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", vm.QualityWarning)
         mfpt = vm.read(shared_data("mfpt/OuterRaceFault_vload_5.mat"), unit="g")
@@ -1003,9 +1006,13 @@ def test_a_declared_speed_the_file_contradicts_is_held(shared_data):
     assert mfpt.meta["rpm"] == pytest.approx(1500, rel=0.01)
     assert "speed_disagrees_file" in fast.flags and fast.confidence <= 0.45
     assert "the file states 1500 rpm" in fast.reason
+    assert fast.top == "undetermined" and fast.extras["candidates"][0]["fault"] == "bearing_outer_race"
+    assert fast.extras["candidates"][0]["p_value"] < 1e-20
+    assert "at the file's speed the bearing test finds bearing_outer_race" in fast.reason
     assert own.top == "bearing_outer_race" and own.confidence > 0.9 and "speed_disagrees_file" not in own.flags
     assert "speed_disagrees_file" not in near.flags
     assert "speed_disagrees_file" in double.flags and double.confidence <= 0.45
+    assert double.top in NOT_NAMED and "bearing_outer_race" in double.reason
 
 
 def test_a_speed_corrected_to_a_line_a_factor_2_comb_rivals_is_held(shared_data):

@@ -10,6 +10,7 @@ import numpy as np
 from ..bearing import FAMILIES, bearing_evidence
 from ..bearing.cage import _cage_stands
 from ..bearing.spectra import _limits
+from .doubts import file_disputes
 from .lines import _row
 from .speed import SPEED_SEARCH, Run, _bearing_contradiction, _confirmed
 
@@ -23,17 +24,8 @@ def _bearing_rows(job: Job, f1: float, speed: dict):
     """One row per bearing family from the statistical test over every channel; the evidence."""
     if job.bearing is None:
         return [], None
-    freqs = job.bearing.frequencies(f1)
-    shaft = f1 / speed.get("fs_ratio", 1)
-    # glitches at a fixed interval of samples stand at a fixed frequency only while the record keeps its
-    # sampling (after angular resampling the repaired comb smears)
-    glitch = () if "order_tracked" in job.flags else tuple(sorted(
-        {job.fs / f["spike_interval_samples"] for f in job.quality.values() if "spike_interval_samples" in f}))
-    ev = bearing_evidence(job.signals, job.fs, f1, freqs, job.bearing.n_balls, band=job.band,
-                          shaft_hz=shaft, f1_known=speed["estimated_rpm"] is not None, whitening=job.prewhitening,
-                          artefact_hz=glitch, speed_search=SPEED_SEARCH, speed_confirmed=_confirmed(speed),
-                          smeared_ball=not ("speed_varies" in job.flags and "order_tracked" not in job.flags),
-                          other_shafts_hz=_other_shafts(job, shaft))
+    ev = _evidence(job, f1, f1 / speed.get("fs_ratio", 1), speed["estimated_rpm"] is not None, SPEED_SEARCH,
+                   _confirmed(speed))
     rows = []
     for name, s in ev.families.items():
         lines = [f"{ln['hz']:.1f} Hz {ln['db']:.0f} dB" for ln in s["lines"] if ln["r"] >= 6.0]
@@ -64,6 +56,59 @@ def _bearing_rows(job: Job, f1: float, speed: dict):
                          not_called=s.get("not_called"),
                          harmonics=[{k: ln[k] for k in ("harmonic", "sideband", "hz", "db")} for ln in s["lines"]]))
     return rows, ev
+
+
+def _evidence(job: Job, f1: float, shaft: float, f1_known: bool, speed_search, speed_confirmed: bool):
+    """The bearing test over every channel at shaft speed f1 (``bearing_evidence``)."""
+    # glitches at a fixed interval of samples stand at a fixed frequency only while the record keeps its
+    # sampling (after angular resampling the repaired comb smears)
+    glitch = () if "order_tracked" in job.flags else tuple(sorted(
+        {job.fs / f["spike_interval_samples"] for f in job.quality.values() if "spike_interval_samples" in f}))
+    return bearing_evidence(job.signals, job.fs, f1, job.bearing.frequencies(f1), job.bearing.n_balls,
+                            band=job.band, shaft_hz=shaft, f1_known=f1_known, whitening=job.prewhitening,
+                            artefact_hz=glitch, speed_search=speed_search, speed_confirmed=speed_confirmed,
+                            smeared_ball=not ("speed_varies" in job.flags and "order_tracked" not in job.flags),
+                            other_shafts_hz=_other_shafts(job, shaft))
+
+
+def file_speed_rows(run: Run, rows: list, ev) -> list:
+    """Where the speed the file states disputes the declared one (``doubts.file_disputes``: no tachometer
+    or 1X line settles which is right), the bearing test is run again at the file's speed. Every bearing
+    line was put where the declared speed says; when the file's speed finds a family the declared one did
+    not call (or none of those it called), the record reads one fault at one speed and another at the
+    other: no bearing fault is named, the families found at the file's speed count against "none" by
+    their p-value, and the answer says so (``job.at_file_rpm``, ``doubts.file_speed``). MFPT's outer-race
+    record declared 1.2 x the 1500 rpm its file states read as ball (p = 1e-27, held at 0.45): at the
+    file's speed it reads as outer race. Where the file's speed finds the families called, or none, the
+    declared speed's answer stands (held by the doubt)."""
+    from .decide import TOP_CONFIDENCE   # here: decide reads this module's CAGE_NOTE
+    job = run.job
+    if ev is None or job.bearing is None or not file_disputes(run):
+        return rows
+    f_file = job.file_rpm / 60.0
+    other = _evidence(job, f_file, f_file, False, None, False)
+    found = {n: float(s["p_value"]) for n, s in other.families.items() if n in FAMILIES and s["found"]}
+    job.at_file_rpm.update(found)
+    called = {r["fault"] for r in rows if r["fault"] in FAMILIES and r["confidence"] >= TOP_CONFIDENCE}
+    if not found or set(found) == called:
+        return rows
+    there = ", ".join(f"{n} (p = {p:.2g})" for n, p in found.items())
+    for r in rows:
+        name, old = r["fault"], r.get("not_called")
+        if name in found:
+            # its p is the file's speed's: what the record holds, wherever the speed is
+            r["not_called"] = "; ".join(filter(None, [
+                f"found at the {job.file_rpm:g} rpm the file states (p = {found[name]:.2g}), which disputes the "
+                f"declared {job.rpm:g} rpm", f"at the declared speed: {old}" if old else None]))
+            r["p_value"] = min(float(r["p_value"]), found[name])
+            r["log10_p"] = float(np.log10(max(r["p_value"], 1e-300)))
+        elif name in called:
+            r["not_called"] = (f"called at the declared {job.rpm:g} rpm only: the {job.file_rpm:g} rpm the file "
+                               f"states disputes it, and there the bearing test finds {there}")
+        else:
+            continue
+        r["confidence"] = 0.0
+    return rows
 
 
 def _other_shafts(job: Job, shaft: float) -> tuple:

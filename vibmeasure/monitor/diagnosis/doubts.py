@@ -140,20 +140,32 @@ def file_speed(run, conf: float, reason: str) -> tuple[float, str]:
     too weak to be found) read as ball at 1.00; CWRU OR007@6_0 declared 2 x read as inner race at 0.92
     through a line at 2.07 x the true speed taken for the 1X. A speed the record contradicts names no
     fault already: there the file's speed is only said."""
+    job = run.job
+    if not file_disputes(run):
+        return conf, reason
+    said = ""
+    if job.at_file_rpm:
+        said = "; at the file's speed the bearing test finds " + ", ".join(
+            f"{name} (p = {p:.2g})" for name, p in job.at_file_rpm.items())
+    return _held(job.flags, "speed_disagrees_file", f"the file states {job.file_rpm:g} rpm, the declared "
+                 f"{job.rpm:g} rpm ({job.rpm / job.file_rpm:.3g} x) was used and no 1X line settles which is right"
+                 f"{said}: check the speed (rpm for Hz, pulses per revolution), or give tach=", conf, reason,
+                 hold="speed_contradicted" not in job.flags)
+
+
+def file_disputes(run) -> bool:
+    """Whether the speed the file states disputes the declared one (``file_speed``): they differ by more
+    than SPEED_NOTED, no tachometer measured the speed, and no 1X line settles it (one at the file's speed;
+    or one at the declared speed with none at the file's)."""
     job, speed = run.job, run.speed
     if job.file_rpm is None or abs(job.rpm / job.file_rpm - 1) <= SPEED_NOTED or speed.get("source") is not None:
-        return conf, reason
+        return False
     measured = speed.get("estimated_rpm")
     if measured is not None and abs(measured / job.file_rpm - 1) <= SPEED_NOTED:
-        return conf, reason
+        return False
     f_file, df = job.file_rpm / 60.0, run.f[1]
     file_line = _line(run.f, run.A, f_file, max(2 * df, SPEED_NOTED * f_file), f_file + 5 * df)[2] >= LINE_DB
-    if measured is not None and abs(measured / job.rpm - 1) <= SPEED_NOTED and not file_line:
-        return conf, reason
-    return _held(job.flags, "speed_disagrees_file", f"the file states {job.file_rpm:g} rpm, the declared "
-                 f"{job.rpm:g} rpm ({job.rpm / job.file_rpm:.3g} x) was used and no 1X line settles which is right: "
-                 "check the speed (rpm for Hz, pulses per revolution), or give tach=", conf, reason,
-                 hold="speed_contradicted" not in job.flags)
+    return not (measured is not None and abs(measured / job.rpm - 1) <= SPEED_NOTED and not file_line)
 
 
 def factor_rival(run, ev, conf: float, reason: str) -> tuple[float, str]:
