@@ -74,23 +74,28 @@ def _evidence(job: Job, f1: float, shaft: float, f1_known: bool, speed_search, s
 def file_speed_rows(run: Run, rows: list, ev) -> list:
     """Where the speed the file states disputes the declared one (``doubts.file_disputes``: no tachometer
     or 1X line settles which is right), the bearing test is run again at the file's speed. Every bearing
-    line was put where the declared speed says; when the file's speed finds a family the declared one did
-    not call (or none of those it called), the record reads one fault at one speed and another at the
-    other: no bearing fault is named, the families found at the file's speed count against "none" by
-    their p-value, and the answer says so (``job.at_file_rpm``, ``doubts.file_speed``). MFPT's outer-race
-    record declared 1.2 x the 1500 rpm its file states read as ball (p = 1e-27, held at 0.45): at the
-    file's speed it reads as outer race. Where the file's speed finds the families called, or none, the
-    declared speed's answer stands (held by the doubt)."""
+    line was put where the declared speed says. When the two speeds' answers differ (the most confident
+    family each would call; at the declared speed none called, at the file's speed a family found), the
+    record reads one fault at one speed and another at the other: no bearing fault is named, the
+    families found at the file's speed count against "none" by their p-value, and the answer says so
+    (``job.at_file_rpm``, ``doubts.file_speed``). MFPT's outer-race record declared 1.2 x the 1500 rpm
+    its file states read as ball (p = 1e-27, held at 0.45): at the file's speed it reads as outer race.
+    Where both give the same answer, or the file's speed would call none, the declared speed's answer
+    stands (held by the doubt)."""
     from .decide import TOP_CONFIDENCE   # here: decide reads this module's CAGE_NOTE
     job = run.job
     if ev is None or job.bearing is None or not file_disputes(run):
         return rows
     f_file = job.file_rpm / 60.0
     other = _evidence(job, f_file, f_file, False, None, False)
-    found = {n: float(s["p_value"]) for n, s in other.families.items() if n in FAMILIES and s["found"]}
+    fams = {n: s for n, s in other.families.items() if n in FAMILIES and s["found"]}
+    found = {n: float(s["p_value"]) for n, s in sorted(fams.items(), key=lambda kv: -kv[1]["confidence"])}
     job.at_file_rpm.update(found)
-    called = {r["fault"] for r in rows if r["fault"] in FAMILIES and r["confidence"] >= TOP_CONFIDENCE}
-    if not found or set(found) == called:
+    called = {r["fault"]: r["confidence"] for r in rows if r["fault"] in FAMILIES and r["confidence"] >= TOP_CONFIDENCE}
+    # the answer each speed gives: its most confident family (at the file's speed, one it would call)
+    there_top = next((n for n in found if fams[n]["confidence"] >= TOP_CONFIDENCE), None)
+    here_top = max(called, key=called.get) if called else None
+    if not found or there_top == here_top or (there_top is None and here_top is not None):
         return rows
     there = ", ".join(f"{n} (p = {p:.2g})" for n, p in found.items())
     for r in rows:
