@@ -3,7 +3,8 @@
 prepare (``job``: channels, units, damage, bearing, limits) -> running speed (``speed``, ``tracking``:
 the 1X, its consistency with fs, order tracking) -> the supply's lines (``mains``) -> ISO 10816-3
 severity (``severity``) -> shaft-order faults (``shaft``: gated by severity) -> bearing families
-(``bearings``: the statistical test of monitor/bearing on every channel, never gated by severity)
+(``bearings``: the statistical test of monitor/bearing on every channel, never gated by severity;
+again at the file's own speed where it disputes the declared one)
 -> the gear (``gears``) -> decision (``decide``: the top, its calibrated confidence and its reason)
 -> the doubts the answer carries (``doubts``: time base, speed, factor 2, the user's band).
 """
