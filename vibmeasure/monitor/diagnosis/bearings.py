@@ -11,7 +11,7 @@ from ..bearing import FAMILIES, bearing_evidence
 from ..bearing.cage import _cage_stands
 from ..bearing.spectra import _limits
 from .doubts import file_disputes
-from .lines import _row
+from .lines import TOP_CONFIDENCE, _row
 from .speed import SPEED_SEARCH, Run, _bearing_contradiction, _confirmed
 
 if TYPE_CHECKING:   # for annotations only
@@ -82,7 +82,6 @@ def file_speed_rows(run: Run, rows: list, ev) -> list:
     its file states read as ball (p = 1e-27, held at 0.45): at the file's speed it reads as outer race.
     Where both give the same answer, or the file's speed would call none, the declared speed's answer
     stands (held by the doubt)."""
-    from .decide import TOP_CONFIDENCE   # here: decide reads this module's CAGE_NOTE
     job = run.job
     if ev is None or job.bearing is None or not file_disputes(run):
         return rows

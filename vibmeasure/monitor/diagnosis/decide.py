@@ -11,13 +11,12 @@ from ..bearing import FAMILIES
 from ..bearing.lines import _log_p_to_conf
 from ..calibration import NONE_BEARING, NONE_GEAR, NONE_SHAFT, UNCHECKED, calibrated
 from .bearings import CAGE_NOTE
+from .lines import TOP_CONFIDENCE
 from .shaft import SHAFT_FAULTS
 
 if TYPE_CHECKING:   # for annotations only
     from .job import Job
 
-
-TOP_CONFIDENCE = 0.5
 
 # --- decision ---------------------------------------------------------------------------------------
 

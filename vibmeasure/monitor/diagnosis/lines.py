@@ -17,6 +17,7 @@ if TYPE_CHECKING:   # for annotations only
 
 
 LINE_DB = 12.0     # a line counts as present this far above its local floor (noise maxima reach ~10 dB)
+TOP_CONFIDENCE = 0.5   # a fault is named from this confidence on (``decide``)
 
 
 def _line(freq, values, f, tol, floor_halfwidth):
