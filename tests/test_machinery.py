@@ -1005,6 +1005,9 @@ def test_a_declared_speed_the_file_contradicts_is_held(shared_data):
         rec = vm.read(shared_data("cwru_fe/OR007@6_0.mat"), fs=12000, unit="g")
         fe = next(n for n in rec.names if n.endswith("_FE_time"))
         double = vm.diagnose(rec, rpm=2 * rec.meta["rpm"], bearing="6203-2RS", channel=fe)
+        # a file speed the record could not be diagnosed at (under 20 turns in it) is flagged, not tried
+        odd = vm.Record.from_array(mfpt.data, fs=mfpt.fs, names=list(mfpt.names), unit="g", meta={"rpm": 0.05})
+        absurd = vm.diagnose(odd, rpm=1800, bearing="MFPT")
         rec14 = vm.read(shared_data("cwru_fe/OR014@6_0.mat"), fs=12000, unit="g")
         slow = vm.diagnose(rec14, rpm=0.85 * rec14.meta["rpm"], bearing="6203-2RS",
                            channel=next(n for n in rec14.names if n.endswith("_FE_time")))
@@ -1019,6 +1022,8 @@ def test_a_declared_speed_the_file_contradicts_is_held(shared_data):
     assert "speed_disagrees_file" in double.flags and double.confidence <= 0.45
     assert double.top in NOT_NAMED and "bearing_outer_race" in double.reason
     assert slow.top == "bearing_outer_race" and slow.confidence <= 0.45 and "speed_disagrees_file" in slow.flags
+    assert "speed_disagrees_file" in absurd.flags and absurd.confidence <= 0.45
+    assert "at the file's speed" not in absurd.reason
 
 
 def test_a_speed_corrected_to_a_line_a_factor_2_comb_rivals_is_held(shared_data):

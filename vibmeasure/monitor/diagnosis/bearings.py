@@ -11,6 +11,7 @@ from ..bearing import FAMILIES, bearing_evidence
 from ..bearing.cage import _cage_stands
 from ..bearing.spectra import _limits
 from .doubts import file_disputes
+from .job import MAX_RPM, MIN_REVOLUTIONS
 from .lines import TOP_CONFIDENCE, _row
 from .speed import SPEED_SEARCH, Run, _bearing_contradiction, _confirmed
 
@@ -86,6 +87,9 @@ def file_speed_rows(run: Run, rows: list, ev) -> list:
     if ev is None or job.bearing is None or not file_disputes(run):
         return rows
     f_file = job.file_rpm / 60.0
+    # a speed the record could not be diagnosed at, had it been declared, is not tried (flagged all the same)
+    if job.file_rpm > MAX_RPM or f_file * job.a.size / job.fs < MIN_REVOLUTIONS:
+        return rows
     other = _evidence(job, f_file, f_file, False, None, False)
     fams = {n: s for n, s in other.families.items() if n in FAMILIES and s["found"]}
     found = {n: float(s["p_value"]) for n, s in sorted(fams.items(), key=lambda kv: -kv[1]["confidence"])}

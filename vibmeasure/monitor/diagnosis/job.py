@@ -15,6 +15,7 @@ from ..bearing import WHITENING
 from .iso import ISO_10816_3
 
 MAX_RPM = 120000.0
+MIN_REVOLUTIONS = 20   # revolutions a record must span for the order resolution
 TYPICAL_FTF_ORDER = 0.38  # the cage turns at about this share of the shaft speed (0.35-0.44 in vm.BEARINGS)
 
 
@@ -195,9 +196,10 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
         raise ParameterError(f"rpm={rpm:g} exceeds {MAX_RPM:g} rpm: no rotating machine this tool covers runs that fast")
     f1 = rpm / 60.0
     T = rec.n_samples / rec.fs
-    if T * f1 < 20:
+    if T * f1 < MIN_REVOLUTIONS:
         raise ParameterError(f"the record spans {T * f1:.1f} shaft revolutions ({T:.3g} s at {rpm:g} rpm); at least "
-                             f"20 are needed for the order resolution (record {20 / f1:.3g} s or more)")
+                             f"{MIN_REVOLUTIONS} are needed for the order resolution (record {MIN_REVOLUTIONS / f1:.3g} s "
+                             "or more)")
     group = 2 if machine_group is None else machine_group
     found = "rigid" if foundation is None else foundation
     if (group, found) not in ISO_10816_3:
