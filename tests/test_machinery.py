@@ -994,8 +994,10 @@ def test_a_declared_speed_the_file_contradicts_is_held(shared_data):
     at the file's speed, which finds the outer race (p ~ 1e-33): one fault at one speed, another at the
     other, so none is named ("undetermined", the outer race its strongest candidate). OR007@6_0 at twice
     its speed reads its own outer race at the file's speed too, and is not named either. Where both
-    speeds give one answer it stands, held: OR014@6_0 declared 15 % slow still reads outer race (a 1X
-    taken off the declared speed, and the file's speed agrees)."""
+    speeds give one answer it stands, held. OR014@6_0 declared 15 % slow took a line 10 % under it for
+    its 1X and called outer race there at p 2e-6; the lines also fit a time base 2 or 4 x the declared,
+    where the inner race reads at p 5e-89: the speeds tried read different faults, none is named, and
+    the outer race, p 5e-99 at the file's speed, is the first candidate."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", vm.QualityWarning)
         mfpt = vm.read(shared_data("mfpt/OuterRaceFault_vload_5.mat"), unit="g")
@@ -1021,7 +1023,9 @@ def test_a_declared_speed_the_file_contradicts_is_held(shared_data):
     assert "speed_disagrees_file" not in near.flags
     assert "speed_disagrees_file" in double.flags and double.confidence <= 0.45
     assert double.top in NOT_NAMED and "bearing_outer_race" in double.reason
-    assert slow.top == "bearing_outer_race" and slow.confidence <= 0.45 and "speed_disagrees_file" in slow.flags
+    assert slow.top == "undetermined" and "speed_disagrees_file" in slow.flags
+    assert slow.extras["candidates"][0]["fault"] == "bearing_outer_race"
+    assert slow.extras["candidates"][0]["p_value"] < 1e-50
     assert "speed_disagrees_file" in absurd.flags and absurd.confidence <= 0.45
     assert "at the file's speed" not in absurd.reason
 
@@ -1143,6 +1147,13 @@ def test_a_record_read_at_half_its_rate_is_noticed_by_its_half_order_line(shared
     machine (whose sub-harmonic reads about as high as its 1X), nothing of the kind."""
     d, right = _at_half_and_own_rate(shared_data("cwru_fe/OR007@3_3.mat"))
     assert "speed_inconsistent" in d.flags and d.confidence <= 0.45 and "fs is 2x" in d.reason
+    # OR007@6_1 so read took the true shaft's harmonics for BPFI +-1X (inner race, held): at the speed
+    # the time base in doubt puts the shaft at (half the declared 1776 rpm; half the 1834 rpm of the
+    # line taken for the 1X reads another comb) the lines read as its outer race, and none is named
+    d6, right6 = _at_half_and_own_rate(shared_data("cwru_fe/OR007@6_1.mat"))
+    assert d6.top == "undetermined" and "speed_inconsistent" in d6.flags
+    assert "at 888 rpm (a time base 2 x the declared) the bearing test finds bearing_outer_race" in d6.reason
+    assert right6.top == "bearing_outer_race"
     assert "speed_inconsistent" not in right.flags and right.top == "bearing_outer_race"
     loose = vm.diagnose(vm.synth.machine(fault="looseness", seed=1, duration=4.0), rpm=1797, bearing="6205-2RS")
     assert loose.top == "looseness" and "speed_inconsistent" not in loose.flags
@@ -1164,18 +1175,35 @@ def test_a_half_order_as_high_as_the_1x_is_said_to_be_ambiguous(shared_data):
 def test_an_answer_at_a_speed_nothing_confirms_is_held(shared_data):
     """CWRU fan-end IR021_0 (inner race) with its sampling rate declared 4x too high: no line stands within
     12 % of the declared 1X, and the true shaft's harmonics fall where the 6203's 2 x BSF harmonics
-    should be (3.987 X): it was called ball at 1.00 with no flag. An answer at a declared speed that
-    nothing confirms is flagged speed_unconfirmed and held at 0.45; at its own rate nothing changes."""
-    rec = vm.read(shared_data("cwru_fe/IR021_0.mat"), fs=12000, unit="g")
-    fe = next(n for n in rec.names if n.endswith("_FE_time"))
-    wrong = vm.Record.from_array(rec.data, fs=4 * rec.fs, names=list(rec.names), unit="g")
+    should be (3.987 X): it was called ball at 1.00 with no flag. A shaft comb standing at 2, 3 or 4 x a
+    declared speed nothing confirms claims its harmonics whichever speed is true: the ball's lines go
+    with them, and the inner race's comb at twice the declared speed contradicts it (no fault named).
+    IR007_2 so read with its three channels is flagged speed_unconfirmed; the bearing test is run again
+    at the comb's speed, which reads the inner race (p ~ 1e-177) where the declared speed read another
+    comb: one fault at one speed, another at the other, none named, the inner race first candidate.
+    At their own rate nothing changes."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", vm.QualityWarning)
-        d = vm.diagnose(wrong, rpm=rec.meta["rpm"], bearing="6203-2RS", channel=fe)
-        right = vm.diagnose(rec, bearing="6203-2RS", channel=fe)
-    assert d.speed["estimated_rpm"] is None and "speed_unconfirmed" in d.flags
-    assert d.confidence <= 0.45 and "no 1X line confirms" in d.reason and "a shaft comb stands at 4 x the declared" in d.reason
-    assert right.top == "bearing_inner_race" and right.confidence > 0.9 and "speed_unconfirmed" not in right.flags
+        out = {}
+        for name in ("IR021_0", "IR007_2"):
+            rec = vm.read(shared_data(f"cwru_fe/{name}.mat"), fs=12000, unit="g")
+            fe = next(n for n in rec.names if n.endswith("_FE_time"))
+            wrong = vm.Record.from_array(rec.data, fs=4 * rec.fs, names=list(rec.names), unit="g")
+            out[name] = (vm.diagnose(wrong, rpm=rec.meta["rpm"], bearing="6203-2RS",
+                                     channel=fe if name == "IR021_0" else None),
+                         vm.diagnose(rec, bearing="6203-2RS", channel=fe))
+    d, right = out["IR021_0"]
+    assert d.top == "undetermined" and "speed_contradicted" in d.flags
+    assert d.speed["bearing_comb"]["family"] == "bearing_inner_race"
+    for d, right in out.values():
+        assert right.top == "bearing_inner_race" and right.confidence > 0.9
+        assert not {"speed_unconfirmed", "speed_contradicted"} & set(right.flags)
+    d, right = out["IR007_2"]
+    assert d.top == "undetermined" and "speed_unconfirmed" in d.flags and d.confidence <= 0.45
+    assert "a shaft comb stands at 4 x the declared" in d.reason
+    assert "(the shaft comb's) the bearing test finds bearing_inner_race" in d.reason
+    assert d.extras["candidates"][0]["fault"] == "bearing_inner_race"
+    assert d.extras["candidates"][0]["p_value"] < 1e-50
     for s in range(3):
         rub = vm.synth.machine(fault="none", shaft_impacts=0.5, snr_db=0, seed=7000 + s, duration=6.0)
         assert vm.diagnose(rub, bearing="6205-2RS", gear=32).top != "gear_mesh"

@@ -53,7 +53,7 @@ class BearingEvidence:
 def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: int, *, band=None,
                      shaft_hz: float | None = None, f1_known: bool = True, whitening=("cepstral",),
                      artefact_hz=(), speed_search: float | None = None, speed_confirmed: bool | None = None,
-                     smeared_ball: bool = True, other_shafts_hz=()) -> BearingEvidence:
+                     smeared_ball: bool = True, other_shafts_hz=(), shaft_combs_hz=()) -> BearingEvidence:
     """Evidence per bearing family over every channel of a record, as a statistical test.
 
     Parameters
@@ -90,6 +90,10 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     other_shafts_hz : tuple of float
         Speeds (Hz) of the machine's other shafts (a gearbox's mating shaft): their harmonics are claimed
         like this shaft's, so that a second shaft's comb is not taken for a bearing's.
+    shaft_combs_hz : tuple of float
+        Fundamentals (Hz) of shaft combs the caller saw in the direct spectrum where the speed is in
+        doubt (a comb at 2, 3 or 4 x a declared speed no 1X confirms): every harmonic is claimed, even
+        where a bearing line could stand, since whichever speed is true they are a shaft's lines.
 
     Returns
     -------
@@ -111,7 +115,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     True
     """
     spectra, measured = _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefact_hz,
-                                           shaft_hz or f1, f1_known, tuple(other_shafts_hz))
+                                           shaft_hz or f1, f1_known, tuple(other_shafts_hz), tuple(shaft_combs_hz))
     fams, votes = _family_summaries(spectra, freqs)
     smeared = _smeared_if_none(fams, spectra, freqs, f1) if smeared_ball else None
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))
@@ -122,7 +126,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
 
 
 def _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefact_hz, shaft_hz, f1_known,
-                       other_shafts_hz=()):
+                       other_shafts_hz=(), shaft_combs_hz=()):
     """Every channel's SES (cage floor divided out before the channels are fused), the fused views,
     and on each the lines explained by the shaft, artefacts, the cage and the families."""
     spectra, measured = [], {}
@@ -137,13 +141,14 @@ def _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefac
     # is 3.987 X, one bin from 4X on a 4 s record) then keeps that line and its multiples
     shaft = any(_shaft_shows(s, shaft_hz, f1_known, freqs) for s in spectra)
     # another shaft (its speed known from the gear ratio) claims its harmonics by the same rule
-    others = [(hz, any(_shaft_shows(s, hz, True, freqs) for s in spectra)) for hz in other_shafts_hz]
+    others = [(hz, any(_shaft_shows(s, hz, True, freqs, f1) for s in spectra)) for hz in other_shafts_hz]
+    others += [(hz, True) for hz in shaft_combs_hz]
     spectra += _fused(spectra)
     for s in spectra:
         for g in artefact_hz:
             _claim_artefact(s, g)
         for hz, shows in others:
-            _claim_shaft(s, hz, True, freqs, contested=shows)
+            _claim_shaft(s, hz, True, freqs, contested=shows, own_f1=f1)
         _explain(s, freqs, f1, shaft_hz, f1_known, n_balls, shaft=shaft)
     if not spectra:
         raise ParameterError(f"whitening={whitening!r} selects no pre-processing; choose from {WHITENING}")

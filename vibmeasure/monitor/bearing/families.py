@@ -12,31 +12,35 @@ from .spectra import _SES
 
 # --- explanation of the lines of one SES -------------------------------------------------------
 
-def _contested(k: np.ndarray, f1: float, freqs: dict, df: float = 0.0, shaft_slip: float = 0.0) -> np.ndarray:
+def _contested(k: np.ndarray, f1: float, freqs: dict, df: float = 0.0, shaft_slip: float = 0.0,
+               own_f1: float | None = None) -> np.ndarray:
     """Which shaft harmonics k x f1 a bearing family's line at its catalogue frequency could be: within
     CONTESTED (plus 1.5 bins, plus the shaft's own uncertainty ``shaft_slip``) of any harmonic of BPFO,
     BPFI, BSF or 2 x BSF, of the +-1X, +-2X (+-FTF, +-2 FTF) sidebands of those the families test, or
     of 1X and 2X themselves (an inner race's load-zone modulation). (Every
     harmonic counts: 2 x BSF = 3.987 X is, to within 0.3 %, every fourth shaft order.) A line found
     only at a larger slip right on a shaft harmonic (the 6203's BPFO, 3.053 X, at -1.7 % on 3X) is
-    taken to be the shaft's."""
+    taken to be the shaft's. The 1X of the sidebands and of the load-zone lines is the bearing's own
+    shaft's (``own_f1``, default f1): another shaft's harmonics are tested against the bearing's lines
+    as its own shaft modulates them."""
+    own = f1 if own_f1 is None else own_f1
     top = float(np.max(k)) * f1 * (1 + SLIP)
     lines = [h * freqs[key] for key in ("BPFO", "BPFI", "BSF", "2xBSF")
              for h in range(1, int(top / freqs[key]) + 1)]
     # an inner-race defect turning through the load zone modulates the envelope at 1X: lines at 1X and
     # 2X of its own, and +-1X, +-2X beside its harmonics; a ball defect likewise at FTF
-    lines += [f1, 2 * f1]
+    lines += [own, 2 * own]
     for key, models in FAMILIES.values():
         for harmonics, side in models:
             if side is not None:
-                sp = f1 if side == "1X" else freqs["FTF"]
+                sp = own if side == "1X" else freqs["FTF"]
                 lines += [h * freqs[key] + m * sp for h in harmonics for m in (-2, -1, 1, 2)]
     lines = np.asarray(lines)
     tol = CONTESTED * lines[None, :] + shaft_slip * k[:, None] * f1 + 1.5 * df
     return np.any(np.abs(k[:, None] * f1 - lines[None, :]) <= tol, axis=1)
 
 
-def _shaft_comb(ses: _SES, f1: float, f1_known: bool, freqs: dict | None):
+def _shaft_comb(ses: _SES, f1: float, f1_known: bool, freqs: dict | None, own_f1: float | None = None):
     """(highest shaft harmonic in the SES, the common slip of the shaft comb, the harmonics no bearing
     line explains, their comb's test or None). The slip is fitted on those harmonics alone when they
     make a significant comb, so that a strong bearing line beside a shaft harmonic cannot pull the
@@ -46,7 +50,7 @@ def _shaft_comb(ses: _SES, f1: float, f1_known: bool, freqs: dict | None):
         return 0, 0.0, np.zeros(0, int), None
     slip = 0.003 if f1_known else 0.01
     ks = np.arange(1, min(k_max, 40) + 1)
-    own = ks if freqs is None else ks[~_contested(ks.astype(float), f1, freqs, ses.freq[1], slip)]
+    own = ks if freqs is None else ks[~_contested(ks.astype(float), f1, freqs, ses.freq[1], slip, own_f1)]
     own_res = _comb(ses, f1, tuple(int(k) for k in own), slip=slip) if own.size >= 2 else None
     res = own_res
     if (res is None or res["logp"] >= np.log(ALPHA)) and own.size < ks.size:
@@ -54,23 +58,25 @@ def _shaft_comb(ses: _SES, f1: float, f1_known: bool, freqs: dict | None):
     return k_max, (res["slip"] if res else 0.0), own, own_res
 
 
-def _shaft_shows(ses: _SES, f1: float, f1_known: bool, freqs: dict) -> bool:
+def _shaft_shows(ses: _SES, f1: float, f1_known: bool, freqs: dict, own_f1: float | None = None) -> bool:
     """Does the SES show the shaft on its own: a line at one of the first OWN_ORDERS shaft harmonics
     that no bearing family's line can explain (``_contested``), or a significant comb of all such
     harmonics (each too weak alone)?"""
-    _, s, own, own_res = _shaft_comb(ses, f1, f1_known, freqs)
+    _, s, own, own_res = _shaft_comb(ses, f1, f1_known, freqs, own_f1)
     if any(_peak_at(ses, k * f1 * (1 + s)) is not None for k in own[own <= OWN_ORDERS]):
         return True
     return bool(own_res is not None and own_res["logp"] < np.log(ALPHA))
 
 
-def _claim_shaft(ses: _SES, f1: float, f1_known: bool, freqs: dict | None = None, contested: bool = True):
+def _claim_shaft(ses: _SES, f1: float, f1_known: bool, freqs: dict | None = None, contested: bool = True,
+                 own_f1: float | None = None):
     """Lines at the shaft harmonics (refined with a small common slip) are the shaft's; with ``contested``
-    False only at the harmonics no bearing line at its catalogue frequency could be."""
-    k_max, s, _, _ = _shaft_comb(ses, f1, f1_known, freqs)
+    False only at the harmonics no bearing line at its catalogue frequency could be (the bearing's
+    own shaft at ``own_f1``, default f1: ``_contested``)."""
+    k_max, s, _, _ = _shaft_comb(ses, f1, f1_known, freqs, own_f1)
     ks = np.arange(1, k_max + 1)
     skip = (np.zeros(ks.size, bool) if contested or freqs is None or not ks.size else
-            _contested(ks.astype(float), f1, freqs, ses.freq[1], 0.003 if f1_known else 0.01))
+            _contested(ks.astype(float), f1, freqs, ses.freq[1], 0.003 if f1_known else 0.01, own_f1))
     for k in ks[~skip]:
         hz = _peak_at(ses, k * f1 * (1 + s))
         if hz is not None:

@@ -10,10 +10,11 @@ import numpy as np
 from ..bearing import FAMILIES, bearing_evidence
 from ..bearing.cage import _cage_stands
 from ..bearing.spectra import _limits
-from .doubts import file_disputes
-from .job import MAX_RPM, MIN_REVOLUTIONS
+from ...core.errors import ParameterError
+from .doubts import file_disputes, shaft_elsewhere
+from .job import MAX_RPM, MIN_REVOLUTIONS, _check_nyquist
 from .lines import TOP_CONFIDENCE, _row
-from .speed import SPEED_SEARCH, Run, _bearing_contradiction, _confirmed
+from .speed import SPEED_NOTED, SPEED_SEARCH, Run, _bearing_contradiction, _confirmed
 
 if TYPE_CHECKING:   # for annotations only
     from .job import Job
@@ -21,12 +22,15 @@ if TYPE_CHECKING:   # for annotations only
 
 # --- bearings ---------------------------------------------------------------------------------------
 
-def _bearing_rows(job: Job, f1: float, speed: dict):
-    """One row per bearing family from the statistical test over every channel; the evidence."""
+def _bearing_rows(job: Job, f1: float, speed: dict, elsewhere: tuple = ()):
+    """One row per bearing family from the statistical test over every channel; the evidence. The
+    shaft combs standing ``elsewhere`` (Hz: ``doubts.shaft_elsewhere``) claim every harmonic of theirs:
+    whichever speed is true, they are a shaft's lines (CWRU fan-end OR007@12_0 with its sampling rate
+    declared twice too high took the true shaft's 2X, 3X, 5X, 7X for BPFI +-1X)."""
     if job.bearing is None:
         return [], None
     ev = _evidence(job, f1, f1 / speed.get("fs_ratio", 1), speed["estimated_rpm"] is not None, SPEED_SEARCH,
-                   _confirmed(speed))
+                   _confirmed(speed), elsewhere)
     rows = []
     for name, s in ev.families.items():
         lines = [f"{ln['hz']:.1f} Hz {ln['db']:.0f} dB" for ln in s["lines"] if ln["r"] >= 6.0]
@@ -59,8 +63,10 @@ def _bearing_rows(job: Job, f1: float, speed: dict):
     return rows, ev
 
 
-def _evidence(job: Job, f1: float, shaft: float, f1_known: bool, speed_search, speed_confirmed: bool):
-    """The bearing test over every channel at shaft speed f1 (``bearing_evidence``)."""
+def _evidence(job: Job, f1: float, shaft: float, f1_known: bool, speed_search, speed_confirmed: bool,
+              elsewhere: tuple = ()):
+    """The bearing test over every channel at shaft speed f1 (``bearing_evidence``); the shafts at
+    ``elsewhere`` (Hz) claim every harmonic of theirs."""
     # glitches at a fixed interval of samples stand at a fixed frequency only while the record keeps its
     # sampling (after angular resampling the repaired comb smears)
     glitch = () if "order_tracked" in job.flags else tuple(sorted(
@@ -69,54 +75,110 @@ def _evidence(job: Job, f1: float, shaft: float, f1_known: bool, speed_search, s
                             band=job.band, shaft_hz=shaft, f1_known=f1_known, whitening=job.prewhitening,
                             artefact_hz=glitch, speed_search=speed_search, speed_confirmed=speed_confirmed,
                             smeared_ball=not ("speed_varies" in job.flags and "order_tracked" not in job.flags),
-                            other_shafts_hz=_other_shafts(job, shaft))
+                            other_shafts_hz=_other_shafts(job, shaft), shaft_combs_hz=elsewhere)
 
 
-def file_speed_rows(run: Run, rows: list, ev) -> list:
-    """Where the speed the file states disputes the declared one (``doubts.file_disputes``: no tachometer
-    or 1X line settles which is right), the bearing test is run again at the file's speed. Every bearing
-    line was put where the declared speed says. When the two speeds' answers differ (the most confident
-    family each would call; at the declared speed none called, at the file's speed a family found), the
-    record reads one fault at one speed and another at the other: no bearing fault is named, the
-    families found at the file's speed count against "none" by their p-value, and the answer says so
-    (``job.at_file_rpm``, ``doubts.file_speed``). MFPT's outer-race record declared 1.2 x the 1500 rpm
-    its file states read as ball (p = 1e-27, held at 0.45): at the file's speed it reads as outer race.
-    Where both give the same answer, or the file's speed would call none, the declared speed's answer
-    stands (held by the doubt)."""
+def other_speed_rows(run: Run, rows: list, ev) -> list:
+    """Where a doubt names another shaft speed the record may hold, the bearing test is run again there:
+    the file's own speed where it disputes the declared one (``doubts.file_disputes``); the speed a
+    time base r x the declared puts the shaft at (``speed_inconsistent``: f1 / r, and f1 / 2 where r is
+    4, whose lines hold a factor 2's); a multiple of the declared speed where a shaft comb stands and no
+    1X confirms the declared one (``doubts.shaft_elsewhere``). Every bearing line was put where the speed
+    used says. When another speed's answer differs from it (the most confident family each would call;
+    at the speed used none called, at the other a family found), the record reads one fault at one speed
+    and another at the other: no bearing fault is named, the families found there count against "none"
+    by their p-value, and the doubt's reason names them (``job.at_other_speeds``). Where every other
+    speed gives the same answer, or calls none, the answer stands (held by its doubt). MFPT's outer-race
+    record declared 1.2 x the 1500 rpm its file states read as ball (p = 1e-27, held at 0.45): at the
+    file's speed it reads as outer race. CWRU fan-end OR007@6_1 read at half its sampling rate took the
+    true shaft's harmonics for BPFI +-1X (inner race, held): at the true speed they are its outer race's.
+
+    Examples
+    --------
+    >>> import vibmeasure as vm
+    >>> rec = vm.synth.machine(fault="bearing_outer_race", rpm=1797, fs=12000.0, duration=4.0, seed=1)
+    >>> told = vm.Record.from_array(rec.data, fs=rec.fs, names=list(rec.names), unit="g", meta={"rpm": 1797})
+    >>> d = vm.diagnose(told, rpm=1.2 * 1797, bearing="6205-2RS")   # the file states 1797 rpm
+    >>> d.top, d.extras["candidates"][0]["fault"]
+    ('undetermined', 'bearing_outer_race')
+    """
     job = run.job
-    if ev is None or job.bearing is None or not file_disputes(run):
+    if ev is None or job.bearing is None:
         return rows
-    f_file = job.file_rpm / 60.0
-    # a speed the record could not be diagnosed at, had it been declared, is not tried (flagged all the same)
-    if job.file_rpm > MAX_RPM or f_file * job.a.size / job.fs < MIN_REVOLUTIONS:
-        return rows
-    other = _evidence(job, f_file, f_file, False, None, False)
-    fams = {n: s for n, s in other.families.items() if n in FAMILIES and s["found"]}
-    found = {n: float(s["p_value"]) for n, s in sorted(fams.items(), key=lambda kv: -kv[1]["confidence"])}
-    job.at_file_rpm.update(found)
     called = {r["fault"]: r["confidence"] for r in rows if r["fault"] in FAMILIES and r["confidence"] >= TOP_CONFIDENCE}
-    # the answer each speed gives: its most confident family (at the file's speed, one it would call)
-    there_top = next((n for n in found if fams[n]["confidence"] >= TOP_CONFIDENCE), None)
     here_top = max(called, key=called.get) if called else None
-    if not found or there_top == here_top or (there_top is None and here_top is not None):
+    here_p = next((float(r["p_value"]) for r in rows if r["fault"] == here_top), 1.0)
+    seen: dict = {}   # family -> (smallest p at another speed, where)
+    disputed = False
+    for hz, kind, where in _other_speeds(run):
+        other = _evidence(job, hz, hz, False, None, False)
+        fams = {n: s for n, s in other.families.items() if n in FAMILIES and s["found"]}
+        found = {n: float(s["p_value"]) for n, s in sorted(fams.items(), key=lambda kv: -kv[1]["confidence"])}
+        job.at_other_speeds[(kind, where)] = found
+        for name, p in found.items():
+            if p < seen.get(name, (1.0, ""))[0]:
+                seen[name] = (p, where)
+        # the answer each speed gives: its most confident family (at the other speed, one it would call,
+        # or a family found there at least as significant as the answer here)
+        there_top = next((n for n in found if fams[n]["confidence"] >= TOP_CONFIDENCE), None)
+        if there_top is None and here_top is not None and found and min(found.values()) <= here_p:
+            there_top = min(found, key=found.get)
+        disputed |= bool(found) and there_top != here_top and not (there_top is None and here_top is not None)
+    if not disputed:
         return rows
-    there = ", ".join(f"{n} (p = {p:.2g})" for n, p in found.items())
+    there = ", ".join(f"{n} at {w} (p = {p:.2g})" for n, (p, w) in seen.items())
     for r in rows:
         name, old = r["fault"], r.get("not_called")
-        if name in found:
-            # its p is the file's speed's: what the record holds, wherever the speed is
+        if name in seen:
+            # its p is the smallest at any speed: what the record holds, wherever the speed is
+            p, where = seen[name]
             r["not_called"] = "; ".join(filter(None, [
-                f"found at the {job.file_rpm:g} rpm the file states (p = {found[name]:.2g}), which disputes the "
-                f"declared {job.rpm:g} rpm", f"at the declared speed: {old}" if old else None]))
-            r["p_value"] = min(float(r["p_value"]), found[name])
+                f"found at {where} (p = {p:.2g}); the speeds tried read different faults",
+                f"called at the {60 * run.f1:.0f} rpm used" if name in called else
+                f"at the {60 * run.f1:.0f} rpm used: {old}" if old else None]))
+            r["p_value"] = min(float(r["p_value"]), p)
             r["log10_p"] = float(np.log10(max(r["p_value"], 1e-300)))
         elif name in called:
-            r["not_called"] = (f"called at the declared {job.rpm:g} rpm only: the {job.file_rpm:g} rpm the file "
-                               f"states disputes it, and there the bearing test finds {there}")
+            r["not_called"] = (f"called at the {60 * run.f1:.0f} rpm used only: the record's lines dispute that "
+                               f"speed, and the bearing test finds {there}")
         else:
             continue
         r["confidence"] = 0.0
     return rows
+
+
+def _other_speeds(run: Run) -> list:
+    """(shaft Hz, kind, where said) of every other speed a doubt names (``other_speed_rows``) at which the
+    record could have been diagnosed, had it been declared (enough turns, the bearing's lines under
+    Nyquist)."""
+    job, speed = run.job, run.speed
+    out = []
+    if file_disputes(run):
+        out.append((job.file_rpm / 60.0, "file", "the file's speed"))
+    r = speed.get("fs_ratio", 1)
+    # from the 1X taken and from the declared speed: a 1X found in a spectrum read at the wrong rate may
+    # be another line near the declared speed (CWRU OR007@6_1 at half its rate: a line 3 % off)
+    bases = [run.f1] + ([job.rpm / 60.0] if abs(run.f1 / (job.rpm / 60.0) - 1) > SPEED_NOTED else [])
+    for q in sorted({r, 2} if r == 4 else {r} - {1}):
+        for base in bases:
+            hz = base / q
+            out.append((hz, "time base", f"{60 * hz:.0f} rpm (a time base {q} x the declared)"))
+    for k in shaft_elsewhere(run):
+        hz = k * job.rpm / 60.0
+        out.append((hz, "comb", f"{60 * hz:.0f} rpm (the shaft comb's)"))
+    return [o for o in out if _diagnosable(job, o[0])]
+
+
+def _diagnosable(job: Job, hz: float) -> bool:
+    """Whether the record could be diagnosed at shaft speed hz: under MAX_RPM, MIN_REVOLUTIONS turns in
+    it, the bearing's third harmonics under Nyquist (``job._check_nyquist``)."""
+    if 60 * hz > MAX_RPM or hz * job.a.size / job.fs < MIN_REVOLUTIONS:
+        return False
+    try:
+        _check_nyquist(job.fs, hz, job.bearing, None)
+    except ParameterError:
+        return False
+    return True
 
 
 def _other_shafts(job: Job, shaft: float) -> tuple:
@@ -165,7 +227,8 @@ def bearing_step(run: Run) -> tuple[list, object, bool]:
     """(rows, evidence, contradicted): the bearing rows unless the speed is contradicted; the bearing's
     own lines standing where another speed puts them contradict it too (``decoys._speed_scan``)."""
     contradicted = "speed_contradicted" in run.job.flags
-    rows, ev = _bearing_rows(run.job, run.f1, run.speed) if not contradicted else ([], None)
+    elsewhere = tuple(k * run.job.rpm / 60.0 for k in shaft_elsewhere(run)) if not contradicted else ()
+    rows, ev = _bearing_rows(run.job, run.f1, run.speed, elsewhere) if not contradicted else ([], None)
     if ev is not None and ev.speed_scan is not None:
         _bearing_contradiction(run.job, run.speed, run.f1, ev.speed_scan)
         contradicted = True

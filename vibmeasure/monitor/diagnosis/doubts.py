@@ -10,7 +10,7 @@ import numpy as np
 from ..bearing.families import HALVES
 from ..bearing.rules import ALPHA, SLIP
 from .lines import LINE_DB, _line
-from .speed import SPEED_NOTED, _confirmed
+from .speed import SPEED_NOTED
 
 DOUBT_CONFIDENCE = 0.45   # a doubtful answer stays under the 0.5 a confident answer needs
 SHAFT_ELSEWHERE = (2, 3, 4)   # a shaft comb at these multiples of a declared 1X that does not show
@@ -28,13 +28,13 @@ def _held(flags: list, flag: str, why: str, conf: float, reason: str, hold: bool
     return conf, reason
 
 
-def time_base(speed: dict, severity: dict, flags: list, conf: float, reason: str) -> tuple[float, str]:
+def time_base(job, speed: dict, severity: dict, conf: float, reason: str) -> tuple[float, str]:
     """When the lines fit the declared speed only at another fs (or another speed by the same factor:
     rpm for Hz, pulses per revolution), every frequency the answer rests on may be off by that factor:
     the ISO zone is withdrawn too (the velocity scales with the time base). CWRU Normal_0 read at a
     quarter of its rate was answered 'none' at 0.97 with a zone from a velocity four times too high.
     (The flag, ``speed_inconsistent``, is set where the lines are found: ``speed._speed``.)"""
-    r = speed.get("fs_ratio", 1)
+    r, flags = speed.get("fs_ratio", 1), job.flags
     if r == 1:
         return conf, reason
     if severity.get("zone") is not None:
@@ -42,7 +42,7 @@ def time_base(speed: dict, severity: dict, flags: list, conf: float, reason: str
         severity["note"] = "; ".join(filter(None, [severity.get("note", ""), (
             f"no zone: the time base is in doubt (the lines fit only at {r}x fs, or {r}x the declared speed)")]))
     return _held(flags, "speed_inconsistent", f"the time base is in doubt, check fs and the speed (a factor {r}: "
-                 "rpm for Hz, pulses per revolution)", conf, reason)
+                 f"rpm for Hz, pulses per revolution){_found_there(job, 'time base')}", conf, reason)
 
 
 def unconfirmed_speed(run, conf: float, reason: str) -> tuple[float, str]:
@@ -53,31 +53,56 @@ def unconfirmed_speed(run, conf: float, reason: str) -> tuple[float, str]:
     shaft harmonics where its 2 x BSF harmonics should be (3.987 X): CWRU fan-end inner-race records
     read as ball at 1.00. Flag ``speed_unconfirmed``. A 1X merely buried in noise (synthetic machines at
     -10 dB) shows no such comb and is not held. A 1X found away from the declared speed
-    (``speed_corrected``) with its harmonics (``speed._confirmed``: the bearing's lines are then searched
-    at other speeds only near a factor 2; without them, at every speed from 0.5 to 2 x) confirms nothing either: a comb counts there when it is not that 1X's own and
-    its first line stands at least as high as that 1X (CWRU fan-end OR021@6_0 read at 4 x fs took a line
-    5.5 % below the declared speed for its 1X and read as ball at 0.72; IR007_1, whose file states a
-    speed 2.4 % slow, shows scattered lines near 2-4 x the declared speed under its strong true 1X)."""
-    speed, job = run.speed, run.job
-    corrected = "speed_corrected" in job.flags and _confirmed(speed)
-    if (speed.get("estimated_rpm") is not None and not corrected) or not speed.get("consistent", True):
+    (``speed_corrected``) confirms nothing either, with its harmonics or without: a comb counts there
+    when it is not that 1X's own and its first line stands at least as high as that 1X (CWRU fan-end
+    OR021@6_0 read at 4 x fs took a line 5.5 % below the declared speed, without harmonics, for its 1X
+    and read as ball at 0.89 with all three channels; IR007_1, whose file states a speed 2.4 % slow,
+    shows scattered lines near 2-4 x the declared speed under its strong true 1X). The bearing test is
+    run again at the comb's speed (``bearings.other_speed_rows``) and what it finds there is said."""
+    job = run.job
+    combs = shaft_elsewhere(run)
+    if not combs:
         return conf, reason
+    corrected = "speed_corrected" in job.flags
+    said = (f"the 1X taken, at {60 * run.f1:.0f} rpm, is off the declared {job.rpm:g} rpm" if corrected else
+            f"no 1X line confirms the declared {job.rpm:g} rpm")
+    return _held(job.flags, "speed_unconfirmed", f"{said}, and a shaft comb stands at {combs[0]} x the declared "
+                 f"speed{_found_there(job, 'comb')}: check the speed and fs, or give tach=", conf, reason)
+
+
+def shaft_elsewhere(run) -> list:
+    """The multiples k of the declared speed (SHAFT_ELSEWHERE) at which a shaft comb stands while no 1X
+    confirms the declared speed (``unconfirmed_speed``): three of the comb's first four harmonics
+    LINE_DB over their floor; beside a 1X found off the declared speed, a comb that is not that 1X's own
+    and whose first line stands at least as high as it."""
+    speed, job = run.speed, run.job
+    # a 1X taken off the declared speed confirms nothing, with its harmonics or without (the bearing's
+    # lines are then searched from 0.5 to 2 x, ``speed._confirmed``, never at 3 or 4 x)
+    corrected = "speed_corrected" in job.flags
+    if (speed.get("estimated_rpm") is not None and not corrected) or not speed.get("consistent", True):
+        return []
     df, f0 = run.f[1], job.rpm / 60.0
     combs = []
     for k in SHAFT_ELSEWHERE:
         if corrected and _harmonic_of(k * f0, run.f1):
             continue
-        db = [_line(run.f, run.A, m * k * f0, max(2 * df, 0.01 * m * k * f0), m * k * f0 + 5 * df)[2]
-              for m in (1, 2, 3, 4)]
-        # beside a 1X found, the comb must outstand it: its first line at least as high
+        lines = [_line(run.f, run.A, m * k * f0, max(2 * df, 0.01 * m * k * f0), m * k * f0 + 5 * df)
+                 for m in (1, 2, 3, 4)]
+        db = [ln[2] for ln in lines]
+        # beside a 1X found, the comb must be no harmonic of it where its line stands (a 1X 1.2 % off
+        # puts its 4X 1.2 % off 4 x the declared speed, inside the search) and outstand it
+        if corrected and lines[0][0] is not None and _harmonic_of(lines[0][0], run.f1):
+            continue
         if sum(d >= LINE_DB for d in db) >= 3 and (not corrected or db[0] >= speed["one_x_db"]):
             combs.append(k)
-    if not combs:
-        return conf, reason
-    said = (f"the 1X taken, at {60 * run.f1:.0f} rpm, is off the declared {job.rpm:g} rpm" if corrected else
-            f"no 1X line confirms the declared {job.rpm:g} rpm")
-    return _held(job.flags, "speed_unconfirmed", f"{said}, and a shaft comb stands at {combs[0]} x the declared "
-                 "speed: check the speed and fs, or give tach=", conf, reason)
+    return combs
+
+
+def _found_there(job, kind: str) -> str:
+    """What the bearing test found at the other speeds of one kind (``bearings.other_speed_rows``), said."""
+    said = [f"at {where} the bearing test finds " + ", ".join(f"{name} (p = {p:.2g})" for name, p in found.items())
+            for (k, where), found in job.at_other_speeds.items() if k == kind and found]
+    return "".join("; " + s for s in said)
 
 
 def _harmonic_of(f: float, f1: float) -> bool:
@@ -143,10 +168,7 @@ def file_speed(run, conf: float, reason: str) -> tuple[float, str]:
     job = run.job
     if not file_disputes(run):
         return conf, reason
-    said = ""
-    if job.at_file_rpm:
-        said = "; at the file's speed the bearing test finds " + ", ".join(
-            f"{name} (p = {p:.2g})" for name, p in job.at_file_rpm.items())
+    said = _found_there(job, "file")
     return _held(job.flags, "speed_disagrees_file", f"the file states {job.file_rpm:g} rpm, the declared "
                  f"{job.rpm:g} rpm ({job.rpm / job.file_rpm:.3g} x) was used and no 1X line settles which is right"
                  f"{said}: check the speed (rpm for Hz, pulses per revolution), or give tach=", conf, reason,
@@ -220,7 +242,7 @@ def hold_all(run, ev, severity: dict, top: str, conf: float, reason: str) -> tup
     """Every doubt in turn: the time base, the unit, a speed the file contradicts, a speed nothing
     confirms, a factor 2 (half-harmonics, a rival comb), a smeared ball at its slip's edge, the user's
     band."""
-    conf, reason = time_base(run.speed, severity, run.job.flags, conf, reason)
+    conf, reason = time_base(run.job, run.speed, severity, conf, reason)
     conf, reason = unit_label(run.job, severity, conf, reason)
     conf, reason = file_speed(run, conf, reason)
     conf, reason = unconfirmed_speed(run, conf, reason)

@@ -18,7 +18,7 @@ from ...core._validate import as_record, memory_guard
 from ...core.errors import warn_quality
 from ...core.units import quantity_of
 from ...core.results import Diagnosis
-from .bearings import _narrow_channels, _plot_material, bearing_step, file_speed_rows
+from .bearings import _narrow_channels, _plot_material, bearing_step, other_speed_rows
 from . import doubts
 from .decide import _decide, _unweighed, candidates
 from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note
@@ -116,7 +116,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     severity, gate = iso_severity(measured, run.job, supply)
     rows = shaft_rows(run, supply, gate, line_frequency)
     b_rows, ev, contradicted = bearing_step(run)
-    b_rows = file_speed_rows(run, b_rows, ev)
+    b_rows = other_speed_rows(run, b_rows, ev)
     narrow = _narrow_channels(ev, run.job, run.f1) if ev is not None and run.job.band is None else []
     rows += b_rows + gear_rows(run)
     gate_rows(rows, run.job.flags, contradicted)
