@@ -213,6 +213,32 @@ def test_shaft_claims_its_harmonics_only_with_a_line_of_its_own(rng):
     assert all(ses.r[int(round(k * f1 / df))] == 0.0 for k in (1, 3, 4, 7, 8, 12))
 
 
+def test_another_shafts_harmonics_are_weighed_against_the_bearing_shafts_sidebands():
+    # a bearing's lines carry +-1X, +-2X sidebands of its own shaft, and an inner race's load zone puts
+    # lines at its own 1X and 2X: another shaft's harmonic is contested by those, never by sidebands
+    # at that other shaft's speed (its own 1X would then contest itself)
+    b = vm.BEARINGS["6205-2RS"]
+    f1, other, df = 25.0, 37.0, 0.1
+    freqs = b.frequencies(f1)
+    assert bf._contested(np.array([1.0]), other, freqs, df)            # as if it were the bearing's shaft
+    assert not bf._contested(np.array([1.0]), other, freqs, df, own_f1=f1)
+    assert bf._contested(np.array([1.0]), 2 * f1, freqs, df, own_f1=f1)   # the bearing shaft's 2X
+
+
+def test_a_shaft_comb_the_caller_names_claims_every_harmonic():
+    # a comb seen in the direct spectrum at a multiple of a speed nothing confirms is a shaft's whichever
+    # speed is true: its harmonics are claimed even where a bearing's lines stand. Named at BPFO, it
+    # takes the outer race's whole comb, which is then found nowhere
+    rec = vm.synth.machine(fault="bearing_outer_race", rpm=1797, fs=12000.0, duration=4.0, seed=1)
+    b = vm.BEARINGS["6205-2RS"]
+    f1 = 1797 / 60
+    freqs = b.frequencies(f1)
+    args = ({"a": rec.data[0]}, 12000.0, f1, freqs, b.n_balls)
+    assert evidence.bearing_evidence(*args).families["bearing_outer_race"]["found"]
+    named = evidence.bearing_evidence(*args, shaft_combs_hz=(freqs["BPFO"],))
+    assert not named.families["bearing_outer_race"]["found"]
+
+
 def test_a_short_healthy_record_makes_no_bearing_call():
     # a healthy 1 s record at 20.48 kHz, 2000 rpm (the IMS rig's format): before the floor ratio was
     # mapped to the exact law of the median, this noise realisation made an inner-race call (confidence

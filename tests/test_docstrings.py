@@ -91,3 +91,35 @@ def test_the_examples_run(name, monkeypatch, tmp_path):
         for test in finder.find(obj, name, globs={}):
             runner.run(test)
     assert runner.failures == 0, f"{name}: {runner.failures} example(s) failed (run with -s to see them)"
+
+
+def _module_names() -> list:
+    import pkgutil
+    return sorted(m.name for m in pkgutil.walk_packages(vm.__path__, "vibmeasure.")
+                  if ".cli" not in m.name and not m.name.endswith("__main__"))
+
+
+def _covered() -> set:
+    """The dotted names of the objects whose examples ``test_the_examples_run`` runs already."""
+    return {f"{o.__module__}.{o.__qualname__}" for o in public_objects().values()}
+
+
+@pytest.mark.parametrize("module", _module_names())
+def test_every_modules_examples_run(module, monkeypatch, tmp_path):
+    """The examples of the functions inside the package (the steps of a pipeline, the bearing test, the
+    readers) run too: an example that no longer runs misleads whoever reads the code to fix it."""
+    import importlib
+    import tempfile
+
+    import matplotlib
+    matplotlib.use("Agg")
+    monkeypatch.chdir(ROOT)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    covered = _covered()
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for test in doctest.DocTestFinder().find(importlib.import_module(module), module):
+            if test.examples and test.name not in covered:
+                runner.run(test)
+    assert runner.failures == 0, f"{module}: {runner.failures} example(s) failed (run with -s to see them)"

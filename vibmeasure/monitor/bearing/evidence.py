@@ -110,7 +110,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     >>> from vibmeasure.monitor.bearing import bearing_evidence
     >>> rec = vm.synth.machine(fault="bearing_outer_race", rpm=1797, fs=12000.0, duration=4.0, seed=1)
     >>> b = vm.BEARINGS["6205-2RS"]
-    >>> ev = bearing_evidence({"a": rec.data[:, 0]}, 12000.0, 1797 / 60, b.frequencies(1797 / 60), b.n_balls)
+    >>> ev = bearing_evidence({"a": rec.data[0]}, 12000.0, 1797 / 60, b.frequencies(1797 / 60), b.n_balls)
     >>> bool(ev.families["bearing_outer_race"]["found"])
     True
     """
