@@ -119,10 +119,13 @@ def other_speed_rows(run: Run, rows: list, ev) -> list:
             if p < seen.get(name, (1.0, ""))[0]:
                 seen[name] = (p, where)
         # the answer each speed gives: its most confident family (at the other speed, one it would call,
-        # or a family found there at least as significant as the answer here)
+        # or a family found there at least as significant as the answer here); against an answer here,
+        # only one of comparable significance (RIVAL_LOG_SHARE) disputes it
         there_top = next((n for n in found if fams[n]["confidence"] >= TOP_CONFIDENCE), None)
         if there_top is None and here_top is not None and found and min(found.values()) <= here_p:
             there_top = min(found, key=found.get)
+        if here_top is not None and there_top is not None and not _rivals(found[there_top], here_p):
+            there_top = None
         disputed |= bool(found) and there_top != here_top and not (there_top is None and here_top is not None)
     if not disputed:
         return rows
@@ -145,6 +148,21 @@ def other_speed_rows(run: Run, rows: list, ev) -> list:
             continue
         r["confidence"] = 0.0
     return rows
+
+
+# A family another speed reads disputes the answer at the speed used where its log p is at least this
+# share of the answer's: a comb at k x the declared speed is also the kX, 2kX, ... of a shaft at the
+# declared speed whose 1X is weak, and a wrong speed's dense sideband models fit strong lines by
+# chance (MFPT's inner race quantised to 8 bits, p 4e-60, against an outer race at 4 x its speed, p
+# 4e-23: 0.38); a right speed's comb rivals the wrong one's (CWRU IR007_1 at 4 x fs: ball 2e-30 at the
+# declared speed, inner race 1e-28 at the comb's: 0.94; OR007@6_1 at half its rate: 0.74)
+RIVAL_LOG_SHARE = 0.5
+
+
+def _rivals(p_there: float, p_here: float) -> bool:
+    """Whether a family found at another speed with p_there is as significant as an answer with p_here
+    (RIVAL_LOG_SHARE of its log p, both floored at 1e-300)."""
+    return np.log(max(p_there, 1e-300)) <= RIVAL_LOG_SHARE * np.log(max(p_here, 1e-300))
 
 
 def _other_speeds(run: Run) -> list:
