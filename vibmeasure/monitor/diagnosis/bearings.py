@@ -84,11 +84,12 @@ def other_speed_rows(run: Run, rows: list, ev) -> list:
     time base r x the declared puts the shaft at (``speed_inconsistent``: f1 / r, and f1 / 2 where r is
     4, whose lines hold a factor 2's); a multiple of the declared speed where a shaft comb stands and no
     1X confirms the declared one (``doubts.shaft_elsewhere``). Every bearing line was put where the speed
-    used says. When another speed's answer differs from it (the most confident family each would call;
-    at the speed used none called, at the other a family found), the record reads one fault at one speed
-    and another at the other: no bearing fault is named, the families found there count against "none"
-    by their p-value, and the doubt's reason names them (``job.at_other_speeds``). Where every other
-    speed gives the same answer, or calls none, the answer stands (held by its doubt). MFPT's outer-race
+    used says. When another speed's answer differs from it (the most confident family each would call,
+    the other speed's of comparable significance: RIVAL_LOG_SHARE; at the speed used none called, at
+    the other a family found), the record reads one fault at one speed and another at the other: no
+    bearing fault is named, every family found at another speed counts against "none" by its smallest
+    p, and the doubt's reason names them (``job.at_other_speeds``). Where every other speed gives the
+    same answer, calls none, or reads far less significantly, the answer stands (held by its doubt). MFPT's outer-race
     record declared 1.2 x the 1500 rpm its file states read as ball (p = 1e-27, held at 0.45): at the
     file's speed it reads as outer race. CWRU fan-end OR007@6_1 read at half its sampling rate took the
     true shaft's harmonics for BPFI +-1X (inner race, held): at the true speed they are its outer race's.

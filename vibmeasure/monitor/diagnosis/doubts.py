@@ -241,12 +241,15 @@ def unit_label(job, severity: dict, conf: float, reason: str) -> tuple[float, st
 def hold_all(run, ev, severity: dict, top: str, conf: float, reason: str) -> tuple[float, str]:
     """Every doubt in turn: the time base, the unit, a speed the file contradicts, a speed nothing
     confirms, a factor 2 (half-harmonics, a rival comb), a smeared ball at its slip's edge, the user's
-    band."""
-    conf, reason = time_base(run.job, run.speed, severity, conf, reason)
-    conf, reason = unit_label(run.job, severity, conf, reason)
-    conf, reason = file_speed(run, conf, reason)
-    conf, reason = unconfirmed_speed(run, conf, reason)
-    conf, reason = half_speed(ev, run.job, conf, reason)
-    conf, reason = factor_rival(run, ev, conf, reason)
-    conf, reason = ball_slip_edge(ev, run.job, top, conf, reason)
-    return band_given(ev, run.job, top, conf, reason)
+    band. An answer that names no fault yet finds one likely ("undetermined", confidence 1 - p_healthy)
+    keeps its confidence: a doubt about the speed puts the fault's name in doubt, not its presence."""
+    named = conf if top != "undetermined" else min(conf, DOUBT_CONFIDENCE)   # nothing to hold: none said
+    named, reason = time_base(run.job, run.speed, severity, named, reason)
+    named, reason = unit_label(run.job, severity, named, reason)
+    named, reason = file_speed(run, named, reason)
+    named, reason = unconfirmed_speed(run, named, reason)
+    named, reason = half_speed(ev, run.job, named, reason)
+    named, reason = factor_rival(run, ev, named, reason)
+    named, reason = ball_slip_edge(ev, run.job, top, named, reason)
+    named, reason = band_given(ev, run.job, top, named, reason)
+    return (conf if top == "undetermined" else named), reason
