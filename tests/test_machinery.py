@@ -925,7 +925,7 @@ def test_a_band_of_the_users_choice_is_judged_beside_the_records_own(shared_data
     """A band of the user's choice decided alone: CWRU fan-end B014_1 (ball) in 1.2-2.1 kHz was called outer
     race at 1.00. Now the band is searched beside the record's own bands (one view among them): a fault
     that only the given band shows is held at 0.45 with the flag band_unconfirmed, and the record's own
-    evidence keeps its say."""
+    evidence keeps its say; against a family the record's own bands call it is no call at all."""
     rec = vm.read(shared_data("cwru_fe/B014_1.mat"), fs=12000, unit="g")
     fe = next(n for n in rec.names if n.endswith("_FE_time"))
     with warnings.catch_warnings():
@@ -956,6 +956,19 @@ def test_a_band_of_the_users_choice_is_judged_beside_the_records_own(shared_data
                           band=(300.0, 900.0))
     assert low.top == "bearing_ball" or (low.top in ("undetermined", "none") and "band_unconfirmed" in low.flags)
     assert low.top != "undetermined" or "bearing_inner_race only the band given" in low.reason
+    # OR007@3_1 (outer race at 1.00 in its own bands) read as ball in 300-900 Hz and as inner race in
+    # 4.2-5.4 kHz, held: a family the band alone shows is no call against the record's own, whose answer
+    # stands, saying what the band read
+    rec = vm.read(shared_data("cwru_fe/OR007@3_1.mat"), fs=12000, unit="g")
+    fe = next(n for n in rec.names if n.endswith("_FE_time"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", vm.QualityWarning)
+        for band in ((300.0, 900.0), (4200.0, 5400.0)):
+            d = vm.diagnose(rec, bearing="6203-2RS", channel=fe, band=band)
+            assert d.top == "bearing_outer_race" and d.confidence > 0.9 and "band_unconfirmed" in d.flags
+            assert "which none of the record's own bands show: the answer is theirs" in d.reason
+            inner = d.faults.set_index("fault").loc["bearing_inner_race"]
+            assert "only the band given shows it" in inner["not_called"]
 
 
 def test_a_speed_declared_half_or_twice_the_true_one_names_no_fault(shared_data):

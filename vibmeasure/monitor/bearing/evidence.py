@@ -187,6 +187,14 @@ def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
             fams[name]["found"] = False   # only ever significant on lines another family explains better
         elif name in FAMILIES and _one_view(fams[name], fams[name]["views"], n_views):
             fams[name]["found"] = False
+    # a family only the user's band claims is no call against one the record's own bands call: a band
+    # that misses the bearing's resonance demodulates clutter (CWRU fan-end OR007@3_1, outer race at 1.00
+    # in its own bands, read as ball in 300-900 Hz and inner race in 4.2-5.4 kHz)
+    own = [n for n in FAMILIES if fams[n]["found"] and not fams[n]["band_given_only"]]
+    for name in FAMILIES:
+        if own and fams[name]["found"] and fams[name]["band_given_only"]:
+            fams[name]["found"] = False
+            fams[name]["against_own"] = own
     return fams, votes
 
 
@@ -211,7 +219,9 @@ def _confidences(fams, votes, smeared, n_sp, n_views):
     (each spectrum votes with the weight of its evidence, -log p, for the family that claimed first),
     times the share of decoy combs it beats on its own spectrum; and why a comb was not called."""
     weight = {n: sum(-s.results[n]["logp"] for s in votes[n]) for n in FAMILIES}
-    total = sum(weight.values())
+    # a family only the user's band shows, refused against the record's own (``_family_summaries``),
+    # casts no votes against them
+    total = sum(w for n, w in weight.items() if not fams[n].get("against_own"))
     names = list(FAMILIES)
     conf = _log_p_to_conf(np.array([fams[n]["log_p"] if fams[n]["found"] else 0.0 for n in names]))
     for n, c in zip(names, conf):
@@ -323,6 +333,8 @@ def _not_called(name: str, fam: dict, n_sp: int, n_views: int) -> str | None:
         why.append("no +-1X sidebands (an inner-race defect turns through the load zone)"
                    if name == "bearing_inner_race" else
                    "no +-FTF sidebands (a ball defect travels with the cage)")
+    if fam.get("against_own"):
+        why.append(f"only the band given shows it, while the record's own bands show {', '.join(fam['against_own'])}")
     if not why and not fam["votes"]:
         why.append("its lines are explained first by another family, the shaft harmonics or the cage comb")
     elif not why and _one_view(fam, fam["views"], n_views):

@@ -116,7 +116,9 @@ def band_given(ev, job, top: str, conf: float, reason: str) -> tuple[float, str]
     kurtogram's or the infogram's, claims it first) rests on that band alone: flag ``band_unconfirmed``.
     A band that misses the bearing's resonance, or reaches down among the shaft harmonics, demodulates
     clutter whose combs look like a fault. An answer that names no fault says so of its strongest
-    bearing candidate too (the flag, no hold: it names nothing)."""
+    bearing candidate too (the flag, no hold: it names nothing). A family the band alone shows is not
+    called against one the record's own bands call (``bearing.evidence._family_summaries``); the answer
+    is then theirs and says what the band read (the flag, no hold)."""
     if ev is None or job.band is None:
         return conf, reason
     if top == "undetermined":   # a candidate that only the band given shows, when it stands in the way
@@ -131,6 +133,11 @@ def band_given(ev, job, top: str, conf: float, reason: str) -> tuple[float, str]
         return _held(job.flags, "band_unconfirmed", f"bearing candidate {name} only the band given "
                      f"({job.band[0]:g}-{job.band[1]:g} Hz) shows{against}: check that band holds the bearing's "
                      "resonance", conf, reason, hold=False)
+    refused = [n for n in ev.families if ev.families[n].get("against_own")]
+    if refused and top in ev.families and not ev.families[top].get("band_given_only"):
+        return _held(job.flags, "band_unconfirmed", f"the band given ({job.band[0]:g}-{job.band[1]:g} Hz) reads "
+                     f"{', '.join(refused)}, which none of the record's own bands show: the answer is theirs; check "
+                     "that band holds the bearing's resonance", conf, reason, hold=False)
     if top not in ev.families or not ev.families[top].get("band_given_only"):
         return conf, reason
     return _held(job.flags, "band_unconfirmed", f"only the band given ({job.band[0]:g}-{job.band[1]:g} Hz) shows "
