@@ -1032,6 +1032,8 @@ def test_a_declared_speed_the_file_contradicts_is_held(shared_data):
     assert fast.top == "undetermined" and fast.extras["candidates"][0]["fault"] == "bearing_outer_race"
     assert fast.extras["candidates"][0]["p_value"] < 1e-20
     assert "at the file's speed the bearing test finds bearing_outer_race" in fast.reason
+    tried = {o["why"]: o for o in fast.speed["other_speeds"]}   # what each speed tried reads, for scripts
+    assert tried["file"]["rpm"] == pytest.approx(mfpt.meta["rpm"]) and tried["file"]["found"]["bearing_outer_race"] < 1e-20
     assert own.top == "bearing_outer_race" and own.confidence > 0.9 and "speed_disagrees_file" not in own.flags
     assert "speed_disagrees_file" not in near.flags
     assert "speed_disagrees_file" in double.flags

@@ -88,7 +88,7 @@ def other_speed_rows(run: Run, rows: list, ev) -> list:
     the other speed's of comparable significance: RIVAL_LOG_SHARE; at the speed used none called, at
     the other a family found), the record reads one fault at one speed and another at the other: no
     bearing fault is named, every family found at another speed counts against "none" by its smallest
-    p, and the doubt's reason names them (``job.at_other_speeds``). Where every other speed gives the
+    p, and the doubt's reason names them (``job.at_other_speeds``, also ``diag.speed["other_speeds"]``). Where every other speed gives the
     same answer, calls none, or reads far less significantly, the answer stands (held by its doubt). MFPT's outer-race
     record declared 1.2 x the 1500 rpm its file states read as ball (p = 1e-27, held at 0.45): at the
     file's speed it reads as outer race. CWRU fan-end OR007@6_1 read at half its sampling rate took the
@@ -115,7 +115,7 @@ def other_speed_rows(run: Run, rows: list, ev) -> list:
         other = _evidence(job, hz, hz, False, None, False)
         fams = {n: s for n, s in other.families.items() if n in FAMILIES and s["found"]}
         found = {n: float(s["p_value"]) for n, s in sorted(fams.items(), key=lambda kv: -kv[1]["confidence"])}
-        job.at_other_speeds[(kind, where)] = found
+        job.at_other_speeds.append({"rpm": 60 * hz, "why": kind, "where": where, "found": found})
         for name, p in found.items():
             if p < seen.get(name, (1.0, ""))[0]:
                 seen[name] = (p, where)
@@ -128,6 +128,8 @@ def other_speed_rows(run: Run, rows: list, ev) -> list:
         if here_top is not None and there_top is not None and not _rivals(found[there_top], here_p):
             there_top = None
         disputed |= bool(found) and there_top != here_top and not (there_top is None and here_top is not None)
+    if job.at_other_speeds:
+        run.speed["other_speeds"] = job.at_other_speeds   # what each speed tried reads, in diag.speed
     if not disputed:
         return rows
     there = ", ".join(f"{n} at {w} (p = {p:.2g})" for n, (p, w) in seen.items())

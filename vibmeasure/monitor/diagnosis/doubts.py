@@ -100,8 +100,9 @@ def shaft_elsewhere(run) -> list:
 
 def _found_there(job, kind: str) -> str:
     """What the bearing test found at the other speeds of one kind (``bearings.other_speed_rows``), said."""
-    said = [f"at {where} the bearing test finds " + ", ".join(f"{name} (p = {p:.2g})" for name, p in found.items())
-            for (k, where), found in job.at_other_speeds.items() if k == kind and found]
+    said = [f"at {o['where']} the bearing test finds " + ", ".join(f"{name} (p = {p:.2g})"
+                                                                    for name, p in o["found"].items())
+            for o in job.at_other_speeds if o["why"] == kind and o["found"]]
     return "".join("; " + s for s in said)
 
 

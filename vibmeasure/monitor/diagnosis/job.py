@@ -41,7 +41,7 @@ class Job:
     quality: dict = field(default_factory=dict)   # channel -> damage found in its samples (``_damage``)
     converted: dict = field(default_factory=dict)  # channel -> the velocity or displacement unit it was read in
     file_rpm: float | None = None   # the speed the file states, when a declared rpm overrides it
-    at_other_speeds: dict = field(default_factory=dict)  # (kind, where) -> {family: p} at a rival speed
+    at_other_speeds: list = field(default_factory=list)  # {rpm, why, where, found: {family: p}} per speed tried
     unit_share: float | None = None  # a velocity/displacement label's high-band share (``_unit_plausibility``)
 
 
