@@ -237,6 +237,11 @@ def test_a_shaft_comb_the_caller_names_claims_every_harmonic():
     assert evidence.bearing_evidence(*args).families["bearing_outer_race"]["found"]
     named = evidence.bearing_evidence(*args, shaft_combs_hz=(freqs["BPFO"],))
     assert not named.families["bearing_outer_race"]["found"]
+    for bad in (float("nan"), 0.0, -5.0):   # a speed that is none is refused, naming the argument
+        with pytest.raises(vm.ParameterError, match="shaft_combs_hz"):
+            evidence.bearing_evidence(*args, shaft_combs_hz=(bad,))
+        with pytest.raises(vm.ParameterError, match="other_shafts_hz"):
+            evidence.bearing_evidence(*args, other_shafts_hz=(bad,))
 
 
 def test_a_short_healthy_record_makes_no_bearing_call():

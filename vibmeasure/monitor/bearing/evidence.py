@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...core._validate import positive
 from ...core.errors import ParameterError
 from .cage import _cage_floor
 from .decoys import _decoy_p, _speed_scan
@@ -102,7 +103,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     Raises
     ------
     ParameterError
-        When ``whitening`` selects no pre-processing.
+        When ``whitening`` selects no pre-processing, or a speed in ``other_shafts_hz`` or
+        ``shaft_combs_hz`` is not a positive finite number.
 
     Examples
     --------
@@ -114,8 +116,10 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     >>> bool(ev.families["bearing_outer_race"]["found"])
     True
     """
+    other_shafts_hz = tuple(positive(hz, "other_shafts_hz") for hz in other_shafts_hz)
+    shaft_combs_hz = tuple(positive(hz, "shaft_combs_hz") for hz in shaft_combs_hz)
     spectra, measured = _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefact_hz,
-                                           shaft_hz or f1, f1_known, tuple(other_shafts_hz), tuple(shaft_combs_hz))
+                                           shaft_hz or f1, f1_known, other_shafts_hz, shaft_combs_hz)
     fams, votes = _family_summaries(spectra, freqs)
     smeared = _smeared_if_none(fams, spectra, freqs, f1) if smeared_ball else None
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))

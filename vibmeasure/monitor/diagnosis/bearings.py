@@ -88,11 +88,12 @@ def other_speed_rows(run: Run, rows: list, ev) -> list:
     the other speed's of comparable significance: RIVAL_LOG_SHARE; at the speed used none called, at
     the other a family found), the record reads one fault at one speed and another at the other: no
     bearing fault is named, every family found at another speed counts against "none" by its smallest
-    p, and the doubt's reason names them (``job.at_other_speeds``, also ``diag.speed["other_speeds"]``). Where every other speed gives the
-    same answer, calls none, or reads far less significantly, the answer stands (held by its doubt). MFPT's outer-race
-    record declared 1.2 x the 1500 rpm its file states read as ball (p = 1e-27, held at 0.45): at the
-    file's speed it reads as outer race. CWRU fan-end OR007@6_1 read at half its sampling rate took the
-    true shaft's harmonics for BPFI +-1X (inner race, held): at the true speed they are its outer race's.
+    p, and the doubt's reason names them (``job.at_other_speeds``, also ``diag.speed["other_speeds"]``).
+    Where every other speed gives the same answer, calls none, or reads far less significantly, the
+    answer stands (held by its doubt). MFPT's outer-race record declared 1.2 x the 1500 rpm its file
+    states read as ball (p = 1e-27, held at 0.45): at the file's speed it reads as outer race. CWRU
+    fan-end OR007@6_1 read at half its sampling rate took the true shaft's harmonics for BPFI +-1X
+    (inner race, held): at the true speed they are its outer race's.
 
     Examples
     --------

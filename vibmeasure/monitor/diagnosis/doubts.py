@@ -167,12 +167,13 @@ def file_speed(run, conf: float, reason: str) -> tuple[float, str]:
     """A declared rpm that differs from the speed the file states (``Job.file_rpm``) by more than
     SPEED_NOTED, where neither a tachometer nor a 1X line settles which is right (a 1X at the file's
     speed; or one at the declared speed with no line at the file's: a shaft's 2X stands at twice its
-    speed, so a line at a declared speed of twice the file's settles nothing): one of them is a mistake (rpm for Hz, pulses per revolution, another shaft, a
-    nameplate speed), and every bearing line was put where the declared one says. Flag
-    ``speed_disagrees_file``. MFPT's outer-race record declared 1.2 x the 1500 rpm its file states (its 1X
-    too weak to be found) read as ball at 1.00; CWRU OR007@6_0 declared 2 x read as inner race at 0.92
-    through a line at 2.07 x the true speed taken for the 1X. A speed the record contradicts names no
-    fault already: there the file's speed is only said."""
+    speed, so a line at a declared speed of twice the file's settles nothing): one of them is a mistake
+    (rpm for Hz, pulses per revolution, another shaft, a nameplate speed), and every bearing line was
+    put where the declared one says. Flag ``speed_disagrees_file``, held; the reason says what the bearing
+    test finds at the file's speed (``bearings.other_speed_rows``). MFPT's outer-race record declared 1.2
+    x the 1500 rpm its file states (its 1X too weak to be found) reads as ball at the declared speed and
+    as outer race at the file's. A speed the record contradicts names no fault already: there the file's
+    speed is only said."""
     job = run.job
     if not file_disputes(run):
         return conf, reason
