@@ -93,7 +93,8 @@ def _damage(x, fs, name, flags, quality, block):
     envelope), and its transients gated out (``quality.transients``, ``quality.gate``: a burst or a
     sensor's settling is no steady running, and it buries the envelope spectrum), first those the RMS
     rule finds in windows of ``block[0]`` samples, then those the whitened signal shows in windows of
-    ``block[1]``; all are reported.
+    ``block[1]``, then single impacts (``quality.isolated_events``) in windows of an eighth of
+    ``block[0]``; all are reported.
     Saturation is only reported: filling the clipped samples made one more wrong call on the robustness
     variants (CWRU B021_3 clipped at 3 x the RMS)."""
     from ...signal import quality as q
@@ -117,6 +118,11 @@ def _damage(x, fs, name, flags, quality, block):
     if hidden:
         x = q.gate(x, hidden, max(1, block[0] // 8))
         runs = _merged(runs + hidden)
+    # a single impact (a knock) rings for milliseconds: judged in quarter-turn windows (quality.EVENT_LEVEL)
+    knocks = q.isolated_events(x, max(16, block[0] // 8))
+    if knocks:
+        x = q.gate(x, knocks, max(1, block[0] // 64))
+        runs = _merged(runs + knocks)
     if runs:
         found["transients"] = len(runs)
         found["transient_seconds"] = float(sum(e - s for s, e in runs) / fs)
@@ -159,7 +165,8 @@ def _quality_note(quality: dict) -> str:
                          f"{f['dropout_seconds']:.3g} s in all, filled in)")
         if "transients" in f:
             parts.append(f"{f['transients']} transient{'s' * (f['transients'] > 1)} (a burst far above the "
-                         f"record's level, or a settling or step of its mean; {f['transient_seconds']:.3g} s in "
+                         f"record's level, a single impact, or a settling or step of its mean; "
+                         f"{f['transient_seconds']:.3g} s in "
                          "all, gated out)")
         if "saturated_share" in f:
             parts.append(f"saturated: {100 * f['saturated_share']:.2g} % of the samples sit at its extremes")
