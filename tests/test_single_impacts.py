@@ -30,7 +30,7 @@ def _knocked(rec, amp=10.0):
 def test_a_single_impact_is_found_where_it_is_and_repeating_impacts_are_not(rng):
     """White noise, 4 s at 12 kHz, windows of 100 samples: a window's RMS spreads by 1/sqrt(2 x 100) = 7 %,
     the loudest of 960 about 1.25 x the median, so nothing is an event. A ring of 40 x the noise (decay
-    time 2.5 ms) puts about 11 x the median into its window, an excess 40 x the loudest elsewhere: one
+    time 2.5 ms) puts about 11 x the median into its window, an excess 40 x the record's own: one
     event, from a window before the ring to two after. Two and three rings far apart: two and three
     events; six: none, more than MAX_EVENTS alike are the record's own rhythm, as a bearing's impacts
     (a synthetic outer-race fault, 107 a second, in every window alike) are. Bad block or NaN: a named
@@ -62,9 +62,10 @@ def test_a_single_impact_is_found_where_it_is_and_repeating_impacts_are_not(rng)
 
 def test_real_recordings_have_a_single_impact_in_one_channel_only(shared_data):
     """Every channel of the 45 CWRU fan-end and 8 MFPT development records as recorded, in quarter-turn
-    windows: six channels of four fan-end records with loud stretches of their own (B007_2 and _3,
-    OR007@12_0 and _1) have one or two events, at most 35 ms of the record (gated, no answer of
-    benchmarks/diagnosis_real.py changes); MFPT's none."""
+    windows: the fan-end channels of two fan-end records with loud moments of their own (B007_3,
+    OR007@12_0) have an event each, 17 ms (gated, no answer of benchmarks/diagnosis_real.py changes);
+    MFPT's none. At EVENT_RATIO 3 six channels had one, and gating OR007@12_1's turned it, under a
+    20 dB tone, into a wrong ball call (benchmarks/diagnosis_robustness.py)."""
     found = []
     for f in sorted(shared_data("cwru_fe").glob("*.mat")):
         rec = vm.read(f, fs=12000, unit="g")
@@ -73,13 +74,12 @@ def test_real_recordings_have_a_single_impact_in_one_channel_only(shared_data):
             events = q.isolated_events(rec.channel(n).astype(float), block)
             if events:
                 found.append((f.stem, n[-7:]))
-                assert sum(e - s for s, e in events) <= 0.035 * rec.fs, (f.stem, n, events)
+                assert sum(e - s for s, e in events) <= 0.02 * rec.fs, (f.stem, n, events)
     for f in sorted(shared_data("mfpt").glob("*.mat")):
         m = sio.loadmat(f, squeeze_me=True)["bearing"]
         x, fs = np.asarray(m["gs"].item(), float), float(m["sr"].item())
         assert q.isolated_events(x, int(round(2 * fs / float(m["rate"].item()))) // 8) == [], f.name
-    assert sorted(found) == [("B007_2", "FE_time"), ("B007_3", "DE_time"), ("B007_3", "FE_time"),
-                             ("OR007@12_0", "FE_time"), ("OR007@12_1", "DE_time"), ("OR007@12_1", "FE_time")]
+    assert sorted(found) == [("B007_3", "FE_time"), ("OR007@12_0", "FE_time")]
 
 
 @pytest.mark.parametrize("path, truth", [("cwru_fe/OR007@3_0.mat", "bearing_outer_race"),
