@@ -403,7 +403,7 @@ def transients(x, block: int, *, whiten: bool = False) -> list[tuple[int, int]]:
 # revolutions it hardly moves the RMS, yet whitened it stands as one impulse above everything else, and
 # the envelope analysis takes its band (kurtogram) or its flat spectrum for the record's: a 2.5 kHz ring
 # (Q 20) at 10 x the RMS a third of the way into the 53 development records took 42 right answers to 30
-# and made one wrong (benchmarks/diagnosis_robustness.py). A bearing's impacts repeat: many windows stand
+# (benchmarks/diagnosis_robustness.py; 39 with the impact gated). A bearing's impacts repeat: many windows stand
 # about as high. An event is a window of ``block`` samples (moved by half a window) whose whitened RMS is
 # EVENT_LEVEL x the median window's and whose excess over the median is EVENT_RATIO x that of the
 # record's own loudest: the loudest window beyond the MAX_EVENTS loudest (each with its neighbours), so
@@ -412,9 +412,10 @@ def transients(x, block: int, *, whiten: bool = False) -> list[tuple[int, int]]:
 # records, whose whitened windows are even to 10 %: 2.1-2.5 x); it is found on 117 of the 143 channels,
 # not where the record's own loud stretches stand as high (fan-end ball faults, MFPT's inner race). As
 # recorded, the development channels' excess ratios run on to 10.9 (fan-end OR007@12_0), 6.9, 4.5, 3.7:
-# real records have loud moments of their own. At a ratio of 3 six channels had an event, and gating
-# OR007@12_1's 17 ms turned it, under a 20 dB tone, into a wrong ball call; at 5, two (OR007@12_0, B007_3,
-# 17 ms each) and no answer changes, while the knock is found on 117 channels instead of 130.
+# real records have loud moments of their own, and gating one can turn a marginal record (at a ratio of
+# 3, six channels have an event, and fan-end OR007@12_1 under a 20 dB tone becomes a wrong ball call).
+# At 5, two channels (OR007@12_0, B007_3; 17 ms each) and no answer changes; the knock is found on 117
+# channels (130 at 3).
 EVENT_LEVEL = 2.0
 EVENT_RATIO = 5.0
 MAX_EVENTS = 3

@@ -30,11 +30,12 @@ DECOY_P = 0.05          # the shaft's count must beat this share of decoy spacin
 FM4_FAULT = 4.0
 MIN_REVOLUTIONS = 10    # revolutions the synchronous average needs
 # FM4 must also beat residuals of the same sideband spectrum with random timing (``impulsiveness``).
-# A confident call needs p <= IMPULSE_P: a diagnosis tests both shafts, and a fleet diagnoses many
+# A confident call needs p <= IMPULSE_P: a diagnosis tests both shafts and a fleet diagnoses many
 # gearboxes, so a level of 0.005 calls a healthy gear at full confidence about once in a hundred
-# diagnoses (on 90 synthetic healthy gearboxes with 2-10 % random tooth errors the smallest p read 0.0049: a
-# 23-tooth pinion with one tooth 3.05 sigma off); at 0.001, local tooth faults at 0 and 10 dB pass on
-# 31 of 60 gearboxes, at 0.002 on 36, the level taken. N_SURROGATES resolves p well below it.
+# diagnoses (on 90 synthetic healthy gearboxes with 2-10 % random tooth errors the smallest p read
+# 0.0049: a 23-tooth pinion with one tooth 3.05 sigma off). Local tooth faults at 0 and 10 dB read
+# p <= 0.001 on 31 of 60 gearboxes, <= 0.002 on 36 (7,999 surrogates): 0.002 is the level taken.
+# N_SURROGATES resolves p well below it.
 N_SURROGATES = 1999
 SURROGATE_CHUNK = 250   # surrogates a pass: bounds memory at 4096 samples a turn
 IMPULSE_P = 0.002
