@@ -209,8 +209,8 @@ def test_the_surrogate_p_holds_its_level_on_random_tooth_errors():
     """Under the null (random tooth errors, no local fault) the surrogate p should be uniform: p <= 0.05
     on about 5 % of the shaft tests. Of 240 tests (120 healthy gearboxes, five pairs, 2/5/10 % errors,
     eight seeds, 30 dB), 5 % is 12 +- 3.4 (binomial): the bound 10 % is 3.5 standard deviations above
-    it. Delaying the orders below half the mesh as their order (a tooth sequence's aliases) gives 9.6 %
-    (1,999 surrogates), the smallest p 0.008 and no gearbox with a call (FM4 >= 4 and p <= IMPULSE_P,
+    it. Delaying the orders below half the mesh as their order (a tooth sequence's aliases) gives 8.8 %
+    (up to 1,999 surrogates), the smallest p 0.008 and no gearbox with a call (FM4 >= 4 and p <= IMPULSE_P,
     0.002); random phases there gave 15 % and two calls at 0.005. The local tooth faults on the same
     pairs at 10 dB (0/5/10 % errors, four seeds) are called on 32 of 60 gearboxes (37 at 0.005, 29 at
     0.001); at least half is asked."""
