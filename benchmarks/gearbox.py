@@ -3,8 +3,10 @@
 
 Sections (a 6205-2RS declared on every record, 6 s at 12 kHz):
 
-- healthy: five gear pairs (32/71 at 1800 and 1797 rpm, 25/47 at 1500, 19/61 at 1200, 23/67 at 2400),
-  tooth errors of 2, 5 and 10 % RMS, 10 and 30 dB, three seeds; diagnosed with no gear, with the gear's
+- healthy: eight gear pairs (32/71 at 1800 and 1797 rpm, 25/47 at 1500, 19/61 at 1200, 23/67 at 2400;
+  and MORE_PAIRS, meshes above the ISO band's 1 kHz: 32/71 at 3000, 61/19 at 1800 (the wheel on the
+  measured shaft, its pinion at 5779 rpm), 40/83 at 3600), tooth errors of 2, 5 and 10 % RMS, 10 and
+  30 dB, three seeds; diagnosed with no gear, with the gear's
   teeth, and with its teeth and the mating shaft's ratio. Counted: confident (>= 0.5) gear calls,
   confident bearing calls, other confident calls, "none", "undetermined".
 - local tooth fault: the same pairs with a local fault on the pinion (synth's gear_mesh: a pulse on the
@@ -32,12 +34,13 @@ import numpy as np
 import vibmeasure as vm
 
 PAIRS = [(1800, 32, 71), (1797, 32, 71), (1500, 25, 47), (1200, 19, 61), (2400, 23, 67)]
+MORE_PAIRS = [(3000, 32, 71), (1800, 61, 19), (3600, 40, 83)]   # healthy and tooth-fault sections only
 FS, DURATION = 12000.0, 6.0
 
 
 def cases():
     """(section, label, synth.machine keywords, rpm, teeth, mating) for every record."""
-    for rpm, z1, z2 in PAIRS:
+    for rpm, z1, z2 in PAIRS + MORE_PAIRS:
         for error in (0.02, 0.05, 0.1):
             for snr in (10, 30):
                 for seed in (0, 1, 2):
