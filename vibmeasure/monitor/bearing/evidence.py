@@ -16,6 +16,13 @@ from .rules import ALPHA, FAMILIES, MIN_VOTES, R_LINE, SAME_DATA, SINGLE_VIEW_P,
 from .smeared import _call_smeared, _smeared_ball
 from .spectra import WHITENING, _fused, _spectra
 
+# a race's fault makes a comb of sharp lines at a fixed frequency, far above combs of the same shape at
+# other fundamentals (every race call on the development records beats all 120 decoys, p = 1/121); where
+# more than this share of decoys score as well, the spectrum's own lines make such combs by chance (a
+# gearbox's two gears repeat together every hunting-tooth period: lines every f1 / teeth)
+RACES = ("bearing_outer_race", "bearing_inner_race")
+RACE_DECOY_P = 0.05
+
 
 @dataclass(frozen=True)
 class BearingEvidence:
@@ -191,6 +198,9 @@ def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
             fams[name]["found"] = False   # only ever significant on lines another family explains better
         elif name in FAMILIES and _one_view(fams[name], fams[name]["views"], n_views):
             fams[name]["found"] = False
+        elif name in RACES and fams[name]["found"] and fams[name].get("decoy_p", 0.0) > RACE_DECOY_P:
+            fams[name]["found"] = False
+            fams[name]["chance_comb"] = True
     # a family only the user's band claims is no call against one the record's own bands call: a band
     # that misses the bearing's resonance demodulates clutter (CWRU fan-end OR007@3_1, outer race at 1.00
     # in its own bands, read as ball in 300-900 Hz and inner race in 4.2-5.4 kHz)
@@ -337,6 +347,10 @@ def _not_called(name: str, fam: dict, n_sp: int, n_views: int) -> str | None:
         why.append("no +-1X sidebands (an inner-race defect turns through the load zone)"
                    if name == "bearing_inner_race" else
                    "no +-FTF sidebands (a ball defect travels with the cage)")
+    if fam.get("chance_comb"):
+        why.append(f"its spectrum makes such combs by chance: {100 * fam['decoy_p']:.0f} % of decoy combs at "
+                   f"fundamentals that are no bearing frequency score as well (a race's comb needs at most "
+                   f"{100 * RACE_DECOY_P:g} %): a dense line spectrum (two gears' hunting-tooth rate, a belt)")
     if fam.get("against_own"):
         why.append(f"only the band given shows it, while the record's own bands show {', '.join(fam['against_own'])}")
     if not why and not fam["votes"]:
