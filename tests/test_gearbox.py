@@ -239,3 +239,24 @@ def test_one_tooth_three_sigma_off_among_random_errors_is_no_confident_gear_faul
     monkeypatch.setattr(gears, "IMPULSE_P", 0.005)
     loose = vm.diagnose(x, rpm=2400, bearing="6205-2RS", gear=gear)
     assert loose.top == "gear_mesh" and loose.confidence > 0.9
+
+
+def test_a_race_comb_the_hunting_tooth_comb_makes_by_chance_is_not_called(monkeypatch):
+    """A healthy 61/19 gearbox at 1800 rpm (the wheel on the measured shaft, 5 % tooth errors, 30 dB,
+    seed 0; benchmarks/gearbox.py): the two gears' errors repeat together once every 19 wheel turns, so
+    the envelope carries a line every 30 / 19 = 1.58 Hz, and the 6205's BPFI +-1X comb found lines on it
+    (161.0, 352.0, 513.1 Hz: harmonics 102, 223, 325 of it), p = 3e-12, called inner race at 0.86. One
+    decoy comb in seven at fundamentals that are no bearing frequency scores as well (decoy p 0.15): the
+    comb is the spectrum's, not the bearing's, and is not called (RACE_DECOY_P 0.05; every race call on
+    the development records beats all 120 decoys)."""
+    from vibmeasure.monitor.bearing import evidence
+    rec = vm.synth.machine(rpm=1800, gear_teeth=61, mating_teeth=19, fs=12000.0, duration=6.0, fault="none",
+                           mesh=1.0, tooth_error=0.05, snr_db=30, seed=0)
+    x = vm.Record.from_array(rec.data[0], fs=12000.0, names=["acc"], unit="g")
+    gear = vm.Gear(61, mating_shaft_ratio=61 / 19)
+    d = vm.diagnose(x, rpm=1800, bearing="6205-2RS", gear=gear)
+    inner = d.faults.set_index("fault").loc["bearing_inner_race"]
+    assert d.top != "bearing_inner_race" and inner.confidence < 0.05 and inner.decoy_p > 0.1, d.reason
+    assert inner.p_value < 1e-6 and "makes such combs by chance" in inner.not_called
+    monkeypatch.setattr(evidence, "RACE_DECOY_P", 1.0)
+    assert vm.diagnose(x, rpm=1800, bearing="6205-2RS", gear=gear).top == "bearing_inner_race"
