@@ -19,7 +19,8 @@ from .spectra import WHITENING, _fused, _spectra
 # a race's fault makes a comb of sharp lines at a fixed frequency, far above combs of the same shape at
 # other fundamentals (every race call on the development records beats all 120 decoys, p = 1/121); where
 # more than this share of decoys score as well, the spectrum's own lines make such combs by chance (a
-# gearbox's two gears repeat together every hunting-tooth period: lines every f1 / teeth)
+# gearbox's two gears repeat together every hunting-tooth period: lines every f1 x the teeth's common
+# factor / the mating gear's teeth)
 RACES = ("bearing_outer_race", "bearing_inner_race")
 RACE_DECOY_P = 0.05
 
