@@ -10,6 +10,8 @@ import numpy as np
 from ..bearing import FAMILIES, bearing_evidence
 from ..bearing.cage import _cage_stands
 from ..bearing.spectra import _limits
+from ..bearing.rules import ALPHA
+from ..bearing.smeared import SMEAR_HUMP_P, SMEAR_HUMPS
 from ...core.errors import ParameterError
 from .doubts import file_disputes, shaft_elsewhere
 from .job import MAX_RPM, MIN_REVOLUTIONS, _check_nyquist
@@ -51,6 +53,10 @@ def _bearing_rows(job: Job, f1: float, speed: dict, elsewhere: tuple = ()):
                     f"claimed first in {s['votes']} spectra")
         else:
             note = "no comb in any envelope spectrum"
+        if sm is not None and not sm["found"] and sm["log_p"] < np.log(ALPHA) and sm["humps"] < SMEAR_HUMPS:
+            note += (f"; the smeared comb's humps at 2 x BSF x 1-3 (p = {np.exp(sm['log_p']):.2g}) are not "
+                     f"called: {sm['humps']} hump(s) stand alone at p < {SMEAR_HUMP_P:g}, {SMEAR_HUMPS} needed "
+                     "(one sharp line inside one hump, another shaft's harmonic, is no smear)")
         if name != "bearing_cage" and s.get("cage_floor_db") is not None and not (sm is not None and sm["found"]):
             note += (f"; its lines are also harmonics of the cage comb, which stands up to "
                      f"{s['cage_floor_db']:.0f} dB there: they count only by what they stand above it")
