@@ -23,6 +23,18 @@ from .spectra import WHITENING, _fused, _spectra
 # factor / the mating gear's teeth)
 RACES = ("bearing_outer_race", "bearing_inner_race")
 RACE_DECOY_P = 0.05
+# Where both gears of a pair are declared (teeth and ratio), that hunting-tooth comb is known: a line
+# every f1 x gcd(z1, z2) / z2. Any line of it has lines of it at +-1X (z2 / gcd steps away), so a BPFI
+# +-1X triplet can stand on it at any frequency, and its lines' random heights reach p = 6e-16 among
+# thousands of such triplets (a healthy 40/83 gearbox at 3600 rpm, inner race at 0.60). A comb every one
+# of whose standing lines (two or more), its frequency refined, lies within HUNT_TOL of a line of that
+# grid is the gearbox's, not the bearing's. A bearing's comb falls on the grid by chance only as often as
+# 2 HUNT_TOL over the grid's spacing in lines (at most 25 % for one carrier and its sidebands, where the
+# grid is HUNT_MIN_SPACING lines; a few per cent for two carriers); a finer grid holds every line and
+# is not tested. Measured on the bearing faults under a two-gear mesh of benchmarks/gearbox.py: no comb
+# called had every line within 0.25 line of the grid; the healthy triplet's were 0.10-0.19 line off.
+HUNT_TOL = 0.25          # lines (bins)
+HUNT_MIN_SPACING = 2.0   # lines (bins)
 
 
 @dataclass(frozen=True)
@@ -62,7 +74,8 @@ class BearingEvidence:
 def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: int, *, band=None,
                      shaft_hz: float | None = None, f1_known: bool = True, whitening=("cepstral",),
                      artefact_hz=(), speed_search: float | None = None, speed_confirmed: bool | None = None,
-                     smeared_ball: bool = True, other_shafts_hz=(), shaft_combs_hz=()) -> BearingEvidence:
+                     smeared_ball: bool = True, other_shafts_hz=(), shaft_combs_hz=(),
+                     hunting_hz: float | None = None) -> BearingEvidence:
     """Evidence per bearing family over every channel of a record, as a statistical test.
 
     Parameters
@@ -103,6 +116,9 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
         Fundamentals (Hz) of shaft combs the caller saw in the direct spectrum where the speed is in
         doubt (a comb at 2, 3 or 4 x a declared speed no 1X confirms): every harmonic is claimed, even
         where a bearing line could stand, since whichever speed is true they are a shaft's lines.
+    hunting_hz : float, optional
+        The spacing (Hz) of a gear pair's hunting-tooth comb (f1 x gcd(z1, z2) / z2): a family whose
+        standing lines all lie on it is not found (HUNT_TOL).
 
     Returns
     -------
@@ -128,7 +144,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     shaft_combs_hz = tuple(positive(hz, "shaft_combs_hz") for hz in shaft_combs_hz)
     spectra, measured = _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefact_hz,
                                            shaft_hz or f1, f1_known, other_shafts_hz, shaft_combs_hz)
-    fams, votes = _family_summaries(spectra, freqs)
+    hunting_hz = None if hunting_hz is None else positive(hunting_hz, "hunting_hz")
+    fams, votes = _family_summaries(spectra, freqs, hunting_hz)
     smeared = _smeared_if_none(fams, spectra, freqs, f1) if smeared_ball else None
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))
     confirmed = f1_known if speed_confirmed is None else speed_confirmed
@@ -167,7 +184,7 @@ def _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefac
     return spectra, measured
 
 
-def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
+def _family_summaries(spectra, freqs, hunting_hz=None) -> tuple[dict, dict]:
     """Each family's evidence (where it claimed first; else where it is strongest), its decoy p, votes
     and views; a family that claims first nowhere, or in one view only, is not found."""
     n_sp = len(spectra)
@@ -202,6 +219,9 @@ def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
         elif name in RACES and fams[name]["found"] and fams[name].get("decoy_p", 0.0) > RACE_DECOY_P:
             fams[name]["found"] = False
             fams[name]["chance_comb"] = True
+        elif name in FAMILIES and fams[name]["found"] and _on_hunting_grid(where, fams[name], hunting_hz):
+            fams[name]["found"] = False
+            fams[name]["hunting_comb"] = hunting_hz
     # a family only the user's band claims is no call against one the record's own bands call: a band
     # that misses the bearing's resonance demodulates clutter (CWRU fan-end OR007@3_1, outer race at 1.00
     # in its own bands, read as ball in 300-900 Hz and inner race in 4.2-5.4 kHz)
@@ -211,6 +231,29 @@ def _family_summaries(spectra, freqs) -> tuple[dict, dict]:
             fams[name]["found"] = False
             fams[name]["against_own"] = own
     return fams, votes
+
+
+def _on_hunting_grid(ses, fam: dict, spacing: float | None) -> bool:
+    """Whether every standing line of a family's comb (two or more), its frequency refined (a parabola
+    through the log power of its peak), lies within HUNT_TOL lines of the hunting-tooth grid."""
+    df = float(ses.freq[1])
+    if spacing is None or spacing < HUNT_MIN_SPACING * df:
+        return False
+    P = ses.amp[: ses.n_valid].astype(float) ** 2
+    standing = [ln["hz"] for ln in fam["lines"] if ln["r"] >= ses.r_line]
+    if len(standing) < 2:
+        return False
+    for hz in standing:
+        i = int(round(hz / df))
+        if not 2 <= i < P.size - 2:
+            return False
+        j = i - 1 + int(np.argmax(P[i - 1: i + 2]))
+        a, b, c = np.log(np.maximum(P[j - 1: j + 2], 1e-300))
+        den = a - 2 * b + c
+        fp = (j + (0.5 * (a - c) / den if den < 0 else 0.0)) * df
+        if abs(fp - round(fp / spacing) * spacing) > HUNT_TOL * df:
+            return False
+    return True
 
 
 def _smeared_if_none(fams, spectra, freqs, f1):
@@ -352,6 +395,10 @@ def _not_called(name: str, fam: dict, n_sp: int, n_views: int) -> str | None:
         why.append(f"its spectrum makes such combs by chance: {100 * fam['decoy_p']:.0f} % of decoy combs at "
                    f"fundamentals that are no bearing frequency score as well (a race's comb needs at most "
                    f"{100 * RACE_DECOY_P:g} %): a dense line spectrum (two gears' hunting-tooth rate, a belt)")
+    if fam.get("hunting_comb"):
+        why.append(f"every line of its comb stands on the gears' hunting-tooth comb (a line every "
+                   f"{fam['hunting_comb']:.3f} Hz: the two gears' tooth errors repeat together), within "
+                   f"{HUNT_TOL:g} of the spectrum's line spacing: the gearbox's lines, not the bearing's")
     if fam.get("against_own"):
         why.append(f"only the band given shows it, while the record's own bands show {', '.join(fam['against_own'])}")
     if not why and not fam["votes"]:

@@ -3,6 +3,7 @@ gated by severity), as table rows with their notes; and what the plots need of i
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -81,7 +82,8 @@ def _evidence(job: Job, f1: float, shaft: float, f1_known: bool, speed_search, s
                             band=job.band, shaft_hz=shaft, f1_known=f1_known, whitening=job.prewhitening,
                             artefact_hz=glitch, speed_search=speed_search, speed_confirmed=speed_confirmed,
                             smeared_ball=not ("speed_varies" in job.flags and "order_tracked" not in job.flags),
-                            other_shafts_hz=_other_shafts(job, shaft), shaft_combs_hz=elsewhere)
+                            other_shafts_hz=_other_shafts(job, shaft), shaft_combs_hz=elsewhere,
+                            hunting_hz=_hunting(job, shaft))
 
 
 def other_speed_rows(run: Run, rows: list, ev) -> list:
@@ -213,6 +215,18 @@ def _other_shafts(job: Job, shaft: float) -> tuple:
     """The mating shaft's speed where a gear with its ratio is given (its harmonics are claimed)."""
     gear = job.gear
     return () if gear is None or gear.mating_shaft_ratio is None else (shaft * gear.mating_shaft_ratio,)
+
+
+def _hunting(job: Job, shaft: float) -> float | None:
+    """The spacing of the gear pair's hunting-tooth comb, shaft x gcd(z1, z2) / z2, where the gear is
+    given with a ratio that makes a whole number of teeth on the mating gear."""
+    gear = job.gear
+    if gear is None or gear.mating_shaft_ratio is None:
+        return None
+    z2 = gear.teeth / gear.mating_shaft_ratio
+    if round(z2) < 1 or abs(z2 - round(z2)) > 1e-3 * z2:
+        return None
+    return shaft * math.gcd(gear.teeth, round(z2)) / round(z2)
 
 
 CAGE_NOTE = "cage-rate modulation (FTF comb): common on healthy bearings; not a fault by itself, trend it"
