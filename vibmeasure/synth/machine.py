@@ -216,8 +216,12 @@ def _healthy_mesh(shaft: _Shaft, rng, teeth: int, tooth_error: float = 0.0, mati
         i = np.floor(x).astype(int) % z
         err = e[i] + (e[(i + 1) % z] - e[i]) * (x - np.floor(x))
         am, pm = am + err, pm + 2 * err
+    # a recorder's anti-alias filter passes about 0.45 fs: a harmonic (with its sidebands) above it is
+    # not recorded, where sampled as it is it would fold onto the lower harmonics' sidebands (a 40-tooth
+    # mesh at 3600 rpm and 12 kHz: its third harmonic, 7.2 kHz, on the second's, 4.8 kHz, mirrored)
+    top = 0.45 * shaft.fs / (teeth * max(shaft.rpm, shaft.rpm0 or 0.0, shaft.rpm1 or 0.0) / 60.0)
     return am * sum(a * np.sin(2 * np.pi * k * teeth * revs + k * pm + rng.uniform(0, 2 * np.pi))
-                    for k, a in ((1, 1.0), (2, 1 / 3), (3, 1 / 6)))
+                    for k, a in ((1, 1.0), (2, 1 / 3), (3, 1 / 6)) if k <= top or k == 1)
 
 
 def _fault_signal(fault, shaft: _Shaft, rng, b, gear, resonance_hz) -> np.ndarray:

@@ -25,14 +25,15 @@ RACES = ("bearing_outer_race", "bearing_inner_race")
 RACE_DECOY_P = 0.05
 # Where both gears of a pair are declared (teeth and ratio), that hunting-tooth comb is known: a line
 # every f1 x gcd(z1, z2) / z2. Any line of it has lines of it at +-1X (z2 / gcd steps away), so a BPFI
-# +-1X triplet can stand on it at any frequency, and its lines' random heights reach p = 6e-16 among
-# thousands of such triplets (a healthy 40/83 gearbox at 3600 rpm, inner race at 0.60). A comb every one
+# +-1X triplet can stand on it at any frequency, and its lines' random heights reach p = 1e-12 among
+# thousands of such triplets (healthy gearboxes with rough gears, 20 % tooth errors: inner race at 0.99
+# for 23/67 at 2400 rpm, 0.68 for 32/71 at 1800, 0.58 for 40/83 at 3600). A comb every one
 # of whose standing lines (two or more), its frequency refined, lies within HUNT_TOL of a line of that
 # grid is the gearbox's, not the bearing's. A bearing's comb falls on the grid by chance only as often as
 # 2 HUNT_TOL over the grid's spacing in lines (at most 25 % for one carrier and its sidebands, where the
 # grid is HUNT_MIN_SPACING lines; a few per cent for two carriers); a finer grid holds every line and
-# is not tested. Measured on the bearing faults under a two-gear mesh of benchmarks/gearbox.py: no comb
-# called had every line within 0.25 line of the grid; the healthy triplet's were 0.10-0.19 line off.
+# is not tested. Measured on benchmarks/gearbox.py: no bearing fault under a two-gear mesh had every line
+# of its comb within 0.25 line of the grid; the four healthy gearboxes' above (seeds 4-7 of 3-8) did.
 HUNT_TOL = 0.25          # lines (bins)
 HUNT_MIN_SPACING = 2.0   # lines (bins)
 

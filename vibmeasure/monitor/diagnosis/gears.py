@@ -57,12 +57,18 @@ def _synchronous_average(x: np.ndarray, j: np.ndarray, per_rev: int) -> np.ndarr
 
 def _residual(x: np.ndarray, fs: float, f_shaft: float, mesh_order: float, others=()) -> tuple | None:
     """(order spectrum, samples a turn) of x's synchronous residual at f_shaft (``residual_moments``)."""
-    # a power of two a turn where it holds the mesh's third harmonic, else every sample a turn offers
-    per_rev = int(min(4096, 2 ** int(np.floor(np.log2(max(fs / f_shaft, 1.0))))))
-    if per_rev < 2 * (3 * mesh_order + 3):
-        per_rev = 2 * int(fs / f_shaft / 2)
-    if per_rev < 2 * (3 * mesh_order + 3) or x.size * f_shaft / fs < MIN_REVOLUTIONS:
+    # the mesh harmonics a turn's samples hold (with +-3 orders): a mesh above a third of Nyquist has its
+    # third harmonic folded or filtered away, and the average is taken on the harmonics below (a 40-tooth
+    # gear at 3600 rpm, 12 kHz: 200 samples a turn hold harmonics 1 and 2; asking for the third left every
+    # such gearbox without FM4, its sidebands alone holding the gear at 0.45)
+    held = [m for m in MESH_HARMONICS if 2 * (m * mesh_order + 3) <= 2 * int(fs / f_shaft / 2)]
+    if not held or x.size * f_shaft / fs < MIN_REVOLUTIONS:
         return None
+    need = 2 * (max(held) * mesh_order + 3)
+    # a power of two a turn where it holds them, else every sample a turn offers
+    per_rev = int(min(4096, 2 ** int(np.floor(np.log2(max(fs / f_shaft, 1.0))))))
+    if per_rev < need:
+        per_rev = 2 * int(fs / f_shaft / 2)
     x = x - x.mean()
     # the other shafts' parts averaged on a fine grid (about 16 samples a bin, gathered from many turns):
     # a coarse one, read back at each sample's bin, leaves a tenth of a strong pattern's high orders
@@ -297,7 +303,7 @@ def gear_rows(run) -> list:
         run.job.flags.append("gear_not_impulsive")
     elif stands and (fm4 is None or fm4 < FM4_FAULT or fm4_p > IMPULSE_P):
         score = min(score, 0.45)
-        why = ("no synchronous average: too few turns, or too few samples a turn for the mesh's third harmonic"
+        why = ("no synchronous average: too few turns, or too few samples a turn for the mesh line"
                if fm4 is None else f"FM4 < {FM4_FAULT:g}" if fm4 < FM4_FAULT else
                f"p > {IMPULSE_P:g} among residuals with random timing")
         note += (f"; held at 0.45: the synchronous residual is not clearly impulsive ({why}), as a local tooth "
