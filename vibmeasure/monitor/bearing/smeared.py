@@ -25,13 +25,17 @@ SMEAR_EXCL = 0.01      # bins within 1 % of a race line (BPFO, BPFI x 1-12, with
 SMEAR_FLOOR_HZ = 40.0  # the floor: a running median over +-40 Hz, wider than a hump
 SMEAR_MARGIN = 5.0     # decades: the comb's p-value stands this far below the best decoy comb's
 SMEAR_SLIPS = 9        # common slips searched within +-SLIP
-# a comb of humps, as a comb of lines, needs two of its members: a smear shows in every hump the floor
-# lets through, while one sharp line inside one hump (another shaft's harmonic) fills that hump alone.
-# Each hump's own sum is tested against its Gamma law; SMEAR_HUMPS must stand at p below SMEAR_HUMP_P.
-# (A healthy 61/19 gearbox's pinion, 96.3 Hz, puts its third harmonic, 75 x the floor, in the second hump
-# of a 6205's 2 x BSF comb at +1 % slip: that hump read p = 2e-18, the others 0.6, and the comb 5e-14, a
-# ball at 0.95. The fan-end ball records called from their humps have two at 1e-5 or below.)
-SMEAR_HUMPS = 2
+# a smear spreads its energy over a hump's bins; a sharp line inside a hump (another shaft's harmonic)
+# fills it from one place. So a hump stands only where its sum, its loudest bin and SMEAR_LINE_BINS either
+# side (a Hann line's main lobe and first sidelobe) left out, is still at p below SMEAR_HUMP_P against
+# its own Gamma law, and a comb needs SMEAR_HUMPS such humps. A healthy 61/19 gearbox's pinion (96.3 Hz)
+# puts its third harmonic, 75 x the floor, in the second hump of a 6205's 2 x BSF comb at +1 % slip:
+# that hump read p = 2e-14 and the comb was called ball at 0.95; without its line the hump reads 0.04.
+# The CWRU fan-end ball records called from their humps keep a hump without its loudest line at 1e-4
+# (B007_2's fan-end channel) to 1e-18 (B007_1's drive end); on the base channel alone B014_0 and B014_1
+# show one hump each, 6e-4 and 2e-7 without it.
+SMEAR_LINE_BINS = 2
+SMEAR_HUMPS = 1
 SMEAR_HUMP_P = 0.01
 # a sum of Hann-windowed periodogram bins varies this much more than one of independent bins: the power
 # correlation of neighbours is (0.25 / 0.375)^2, of next neighbours (0.0625 / 0.375)^2
@@ -71,8 +75,19 @@ def _wide_ratio(ses: _SES, freqs: dict, f1: float, races: bool = True) -> tuple[
     return r / max(scale, 1e-300), keep
 
 
+def _broad_log_p(r: np.ndarray, sel: np.ndarray, shape: float) -> float:
+    """log p of a hump's sum over its kept bins with its loudest bin and SMEAR_LINE_BINS either side
+    left out (Gamma law as ``_smear_comb``'s): what stands of it without its sharpest line."""
+    sel = sel.copy()
+    if sel.any():
+        top = int(np.argmax(np.where(sel, r, -np.inf)))
+        sel[max(0, top - SMEAR_LINE_BINS): top + SMEAR_LINE_BINS + 1] = False
+    total, m = float(r[sel].sum()), int(sel.sum())
+    return _log_gamma_sf(total * shape / HANN_VAR, m * shape / HANN_VAR) if total > 0 and m else 0.0
+
+
 def _smear_comb(r: np.ndarray, keep: np.ndarray, df: float, f0: float, shape: float) -> tuple[float, float, list]:
-    """(log p, slip, [(centre Hz, mean ratio, log p of the hump alone)]) of the best comb of humps at f0
+    """(log p, slip, [(centre Hz, mean ratio, the hump's ``_broad_log_p``)]) of the best comb of humps at f0
     x 1-3 over the common slips searched; under noise the sum over M kept bins of a mean of ``shape``
     spectra is about Gamma(M shape / HANN_VAR) x HANN_VAR / shape (moment-matched for the window's
     correlation)."""
@@ -88,9 +103,7 @@ def _smear_comb(r: np.ndarray, keep: np.ndarray, df: float, f0: float, shape: fl
             hump, mh = float(r[lo:hi][sel].sum()), int(sel.sum())
             tot += hump
             m += mh
-            kh = mh * shape / HANN_VAR
-            bands.append((c, hump / mh if mh else 0.0,
-                          _log_gamma_sf(hump * shape / HANN_VAR, kh) if hump > 0 and mh else 0.0))
+            bands.append((c, hump / mh if mh else 0.0, _broad_log_p(r[lo:hi], sel, shape)))
         if m < 10 or len(bands) < 2:
             continue
         k = m * shape / HANN_VAR

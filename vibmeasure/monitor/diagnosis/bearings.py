@@ -56,8 +56,8 @@ def _bearing_rows(job: Job, f1: float, speed: dict, elsewhere: tuple = ()):
             note = "no comb in any envelope spectrum"
         if sm is not None and not sm["found"] and sm["log_p"] < np.log(ALPHA) and sm["humps"] < SMEAR_HUMPS:
             note += (f"; the smeared comb's humps at 2 x BSF x 1-3 (p = {np.exp(sm['log_p']):.2g}) are not "
-                     f"called: {sm['humps']} hump(s) stand alone at p < {SMEAR_HUMP_P:g}, {SMEAR_HUMPS} needed "
-                     "(one sharp line inside one hump, another shaft's harmonic, is no smear)")
+                     f"called: without its loudest line no hump stands at p < {SMEAR_HUMP_P:g} (a sharp line "
+                     "inside a hump, another shaft's harmonic, is no smear)")
         if name != "bearing_cage" and s.get("cage_floor_db") is not None and not (sm is not None and sm["found"]):
             note += (f"; its lines are also harmonics of the cage comb, which stands up to "
                      f"{s['cage_floor_db']:.0f} dB there: they count only by what they stand above it")
