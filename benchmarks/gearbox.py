@@ -18,11 +18,13 @@ Sections (a 6205-2RS declared on every record, 6 s at 12 kHz):
 - rubs (one impact a turn, 0.5 and 1 x the fault RMS) beside a 1 g mesh: gear calls.
 
 Targets (issue 46): no confident gear call on a healthy gearbox; no confident wrong bearing call. Also
-counted: answers flagged ``band_limited`` (none of these records went through a filter).
+counted: answers flagged ``band_limited`` (none of these records went through a filter), and the
+healthy records whose speed (the 1X, or the mesh over the teeth where a gear is declared) was found
+within 1 % of the true one.
 ``--save FILE`` writes the records (npz) and their truths; ``--load FILE`` diagnoses saved records
 with whichever vibmeasure is imported (a previous release run from its own checkout).
 
-    python benchmarks/gearbox.py [--save FILE | --load FILE]      (about 2 min)
+    python benchmarks/gearbox.py [--save FILE | --load FILE]      (about 3 min)
 """
 
 import collections
@@ -104,6 +106,7 @@ def main(argv):
     tally = collections.defaultdict(collections.Counter)
     wrong = []
     limited = collections.Counter()
+    speed_ok = collections.Counter()   # (declared, right) over the healthy records: the 1X or the mesh within 1 %
     for section, label, x, rpm, z1, z2, truth in recs:
         gears = {"no gear": None, "teeth": z1, "teeth and ratio": vm.Gear(z1, mating_shaft_ratio=z1 / z2)}
         if section != "healthy":
@@ -119,6 +122,9 @@ def main(argv):
             tally[(section, name)][kind] += 1
             if "band_limited" in d.flags:   # a filter's stop band read where the record measures its band
                 limited[section] += 1
+            if section == "healthy":
+                est = d.speed.get("estimated_rpm")
+                speed_ok[(name, est is not None and abs(est / rpm - 1) <= 0.01)] += 1
             if kind.startswith("confident") and "(right)" not in kind:
                 wrong.append(f"{section}, {label}, {name}: {d.top} {d.confidence:.2f}")
     print(f"{'section':<15}{'declared':<18}answers")
@@ -126,6 +132,9 @@ def main(argv):
         print(f"{section:<15}{name:<18}" + ", ".join(f"{k} {v}" for k, v in sorted(c.items())))
     print("\nflagged band_limited (no filter on these records): "
           + ", ".join(f"{sec} {limited[sec]}" for sec in dict.fromkeys(k[0] for k in tally)))
+    print("speed found within 1 % on the healthy records: " + ", ".join(
+        f"{name} {speed_ok[(name, True)]} of {speed_ok[(name, True)] + speed_ok[(name, False)]}"
+        for name in dict.fromkeys(n for n, _ in speed_ok)))
     print(f"\nconfident wrong answers: {len(wrong)}")
     for w in wrong:
         print("  " + w)
