@@ -53,7 +53,7 @@ ONE_X_CONFIRMS = 2
 # shaft at 3000 or 3600 rpm turns at the line frequency, whose lines are not taken for a 1X (``mains``),
 # and the mating shaft's 2X, 3.6 % under the true 1X of a 40/83 gearbox at 3600 rpm with its comb of
 # harmonics, was taken for it. On the 192 healthy records of benchmarks/gearbox.py the speed is found
-# within 1 % on 189 with the gear and its ratio declared, on 138 by the 1X search alone. Where no 1X
+# within 1 % on 189 with the gear and its ratio declared, on 136 by the 1X search alone. Where no 1X
 # stands at the mesh's speed (a wrong tooth count, no mesh) the search goes on as without a gear.
 MESH_DB = 20.0
 
