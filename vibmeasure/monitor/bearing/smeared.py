@@ -103,14 +103,15 @@ def _smear_comb(r: np.ndarray, keep: np.ndarray, df: float, f0: float, shape: fl
             hump, mh = float(r[lo:hi][sel].sum()), int(sel.sum())
             tot += hump
             m += mh
-            bands.append((c, hump / mh if mh else 0.0, _broad_log_p(r[lo:hi], sel, shape)))
+            bands.append((c, hump / mh if mh else 0.0, (lo, hi)))
         if m < 10 or len(bands) < 2:
             continue
         k = m * shape / HANN_VAR
         logp = _log_gamma_sf(tot * shape / HANN_VAR, k) if tot > 0 else 0.0
         if logp < best[0]:
             best = (logp, float(s), bands)
-    return best
+    # each hump without its loudest line, at the best slip only (the decoys' many slips need none)
+    return best[0], best[1], [(c, mean, _broad_log_p(r[lo:hi], keep[lo:hi], shape)) for c, mean, (lo, hi) in best[2]]
 
 
 def _smear_decoys(freqs: dict, f1: float) -> np.ndarray:
