@@ -125,3 +125,21 @@ def test_the_hunting_tooth_spacing_needs_whole_teeth():
         b = vm.BEARINGS["6205-2RS"]
         evidence.bearing_evidence({"a": np.random.default_rng(0).normal(size=24000)}, 12000.0, 30.0,
                                   b.frequencies(30.0), b.n_balls, hunting_hz=np.nan)
+
+
+@pytest.mark.parametrize("case", [(1800, 32, 71), (2400, 23, 67)])
+def test_a_speed_declared_half_the_mesh_s_is_doubted(case):
+    """A healthy gearbox (5 % tooth errors, 10 dB, seed 0) declared at half its speed reads its true 1X
+    as 2X: "2X/1X" of 10-14, misalignment at 1.00, unflagged. With the gear declared, its mesh stands at
+    twice where the declared speed puts it, with a 1X there: flag speed_doubtful, the answer held at 0.45
+    and the reason saying so. (Without a gear the pattern alone cannot tell a factor 2 from
+    misalignment: left as it was.) Oracle: the mesh at teeth x the true speed."""
+    rpm, z1, z2 = case
+    x = _gearbox(rpm, z1, z2, 0.05, 10, 0)
+    for gear in (z1, vm.Gear(z1, mating_shaft_ratio=z1 / z2)):
+        d = _diagnose(x, rpm / 2, gear)
+        assert "speed_doubtful" in d.flags and d.confidence <= 0.45
+        assert d.speed["mesh_factor"] == 2.0 and d.speed["mesh_hz"] == pytest.approx(z1 * rpm / 60, rel=5e-4)
+        assert "2 x where the declared" in d.reason
+    right = _diagnose(x, rpm, z1)
+    assert "mesh_factor" not in right.speed and "speed_doubtful" not in right.flags

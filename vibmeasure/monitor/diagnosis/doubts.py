@@ -163,6 +163,22 @@ def half_speed(ev, job, conf: float, reason: str) -> tuple[float, str]:
                  "pulses per revolution)", conf, reason)
 
 
+def mesh_speed(run, conf: float, reason: str) -> tuple[float, str]:
+    """A declared gear whose mesh stands not at teeth x the declared speed but at twice or half that,
+    with a 1X at its speed (``speed._speed``: ``speed["mesh_factor"]``): the speed may be off by that
+    factor, and every order the answer rests on with it. A healthy 32/71 gearbox at 1800 rpm declared at
+    900 read its true 1X as 2X, "2X/1X = 10.4", and was called misalignment at 1.00: flag
+    ``speed_doubtful``, held at 0.45."""
+    q = run.speed.get("mesh_factor")
+    if q is None:
+        return conf, reason
+    job = run.job
+    return _held(job.flags, "speed_doubtful", f"the gear's mesh ({job.gear.teeth} teeth) stands at "
+                 f"{run.speed['mesh_hz']:.1f} Hz, {q:g} x where the declared {job.rpm:g} rpm puts it, with a 1X "
+                 f"at its speed: the speed may be {q:g} x the declared (rpm for Hz, pulses per revolution)",
+                 conf, reason)
+
+
 def file_speed(run, conf: float, reason: str) -> tuple[float, str]:
     """A declared rpm that differs from the speed the file states (``Job.file_rpm``) by more than
     SPEED_NOTED, where neither a tachometer nor a 1X line settles which is right (a 1X at the file's
@@ -248,14 +264,15 @@ def unit_label(job, severity: dict, conf: float, reason: str) -> tuple[float, st
 
 
 def hold_all(run, ev, severity: dict, top: str, conf: float, reason: str) -> tuple[float, str]:
-    """Every doubt in turn: the time base, the unit, a speed the file contradicts, a speed nothing
-    confirms, a factor 2 (half-harmonics, a rival comb), a smeared ball at its slip's edge, the user's
+    """Every doubt in turn: the time base, the unit, a speed the file contradicts, a gear's mesh at
+    twice or half the declared speed's, a speed nothing confirms, a factor 2 (half-harmonics, a rival comb), a smeared ball at its slip's edge, the user's
     band. An answer that names no fault yet finds one likely ("undetermined", confidence 1 - p_healthy)
     keeps its confidence: a doubt about the speed puts the fault's name in doubt, not its presence."""
     named = conf if top != "undetermined" else min(conf, DOUBT_CONFIDENCE)   # nothing to hold: none said
     named, reason = time_base(run.job, run.speed, severity, named, reason)
     named, reason = unit_label(run.job, severity, named, reason)
     named, reason = file_speed(run, named, reason)
+    named, reason = mesh_speed(run, named, reason)
     named, reason = unconfirmed_speed(run, named, reason)
     named, reason = half_speed(ev, run.job, named, reason)
     named, reason = factor_rival(run, ev, named, reason)

@@ -88,9 +88,15 @@ def _speed(job: Job, f, A):
     f1 = job.rpm / 60.0
     meshed = _mesh_one_x(job, f, A, f1)
     found = meshed[:3] if meshed else _one_x(f, A, f1, job.mains)
+    # no mesh at the declared speed, but one at twice or half it, with its 1X: the speed may be off by that
+    # factor (``doubts.mesh_speed``); a mesh cannot move, where a 2X ten times the 1X is also misalignment
+    elsewhere = None if meshed or job.gear is None else next(
+        ((q, m[3]) for q in (2.0, 0.5) if (m := _mesh_one_x(job, f, A, q * f1)) is not None), None)
     snr1 = found[1] if found else _line(f, A, f1, max(SPEED_SEARCH * f1, 2 * df), f1 + 5 * df)[2]
     speed = {"declared_rpm": job.rpm, "estimated_rpm": None, "one_x_db": snr1, "consistent": True, "note": "",
              "fs_ratio": 1}
+    if elsewhere is not None:
+        speed["mesh_factor"], speed["mesh_hz"] = elsewhere
     if found:
         f1 = found[0]
         speed["estimated_rpm"] = 60 * f1
