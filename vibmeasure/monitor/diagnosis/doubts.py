@@ -265,8 +265,8 @@ def unit_label(job, severity: dict, conf: float, reason: str) -> tuple[float, st
 
 def hold_all(run, ev, severity: dict, top: str, conf: float, reason: str) -> tuple[float, str]:
     """Every doubt in turn: the time base, the unit, a speed the file contradicts, a gear's mesh at
-    twice or half the declared speed's, a speed nothing confirms, a factor 2 (half-harmonics, a rival comb), a smeared ball at its slip's edge, the user's
-    band. An answer that names no fault yet finds one likely ("undetermined", confidence 1 - p_healthy)
+    twice or half the declared speed's, a speed nothing confirms, a factor 2 (half-harmonics, a rival
+    comb), a smeared ball at its slip's edge, the user's band. An answer that names no fault yet finds one likely ("undetermined", confidence 1 - p_healthy)
     keeps its confidence: a doubt about the speed puts the fault's name in doubt, not its presence."""
     named = conf if top != "undetermined" else min(conf, DOUBT_CONFIDENCE)   # nothing to hold: none said
     named, reason = time_base(run.job, run.speed, severity, named, reason)

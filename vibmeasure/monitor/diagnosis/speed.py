@@ -68,6 +68,8 @@ def _mesh_one_x(job: Job, f, A, f1):
     if hi + 5 * df >= f[-1]:
         return None
     k = np.flatnonzero(np.abs(f - z * f1) <= SPEED_SEARCH * z * f1)
+    if k.size == 0:
+        return None
     i = int(k[np.argmax(A[k])])   # the strongest line there: a local peak standing MESH_DB
     if not (1 <= i < A.size - 1 and A[i] >= A[i - 1] and A[i] > A[i + 1]):
         return None
