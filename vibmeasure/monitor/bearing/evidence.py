@@ -11,6 +11,7 @@ from ...core.errors import ParameterError
 from .cage import _cage_floor
 from .decoys import _decoy_p, _speed_scan
 from .families import HALVES, _accepted, _claim_artefact, _claim_shaft, _explain, _shaft_shows
+from .grid import line_grid
 from .lines import _log_p_to_conf
 from .rules import ALPHA, FAMILIES, MIN_VOTES, R_LINE, SAME_DATA, SINGLE_VIEW_P, SLIP
 from .smeared import _call_smeared, _smeared_ball
@@ -191,7 +192,7 @@ def _family_summaries(spectra, freqs, hunting_hz=None) -> tuple[dict, dict]:
     n_sp = len(spectra)
     votes = {name: [s for s in spectra if s.primary == name] for name in FAMILIES}
     n_views = _views(spectra)   # how many distinct views the record offers (one with a user's band= and channel)
-    fams = {}
+    fams, grids = {}, {}   # grids: each spectrum's measured line grid (``_measured_grid``), once
     for name in list(FAMILIES) + ["bearing_cage"]:
         key = "FTF" if name == "bearing_cage" else FAMILIES[name][0]
         pool = votes.get(name) or spectra
@@ -223,6 +224,11 @@ def _family_summaries(spectra, freqs, hunting_hz=None) -> tuple[dict, dict]:
         elif name in FAMILIES and fams[name]["found"] and _on_hunting_grid(where, fams[name], hunting_hz):
             fams[name]["found"] = False
             fams[name]["hunting_comb"] = hunting_hz
+        elif name in FAMILIES and fams[name]["found"] and hunting_hz is None:
+            grid = grids[id(where)] if id(where) in grids else grids.setdefault(id(where), _measured_grid(where, freqs))
+            if grid is not None and _on_hunting_grid(where, fams[name], grid[0]):
+                fams[name]["found"] = False
+                fams[name]["line_grid"] = grid
     # a family only the user's band claims is no call against one the record's own bands call: a band
     # that misses the bearing's resonance demodulates clutter (CWRU fan-end OR007@3_1, outer race at 1.00
     # in its own bands, read as ball in 300-900 Hz and inner race in 4.2-5.4 kHz)
@@ -232,6 +238,13 @@ def _family_summaries(spectra, freqs, hunting_hz=None) -> tuple[dict, dict]:
             fams[name]["found"] = False
             fams[name]["against_own"] = own
     return fams, votes
+
+
+def _measured_grid(ses, freqs) -> tuple | None:
+    """A spectrum's dense line grid, measured (``grid.line_grid``): where no gear pair is declared, a
+    gearbox's hunting-tooth comb is found from its lines (healthy gearboxes declared without their gear,
+    under a user's band or a speed 0.8 x the true one, read as ball at 0.68-0.81 on it)."""
+    return line_grid(ses.freq, ses.r, ses.n_valid, ses.r_line, freqs["FTF"], HUNT_MIN_SPACING)
 
 
 def _on_hunting_grid(ses, fam: dict, spacing: float | None) -> bool:
@@ -396,6 +409,12 @@ def _not_called(name: str, fam: dict, n_sp: int, n_views: int) -> str | None:
         why.append(f"its spectrum makes such combs by chance: {100 * fam['decoy_p']:.0f} % of decoy combs at "
                    f"fundamentals that are no bearing frequency score as well (a race's comb needs at most "
                    f"{100 * RACE_DECOY_P:g} %): a dense line spectrum (two gears' hunting-tooth rate, a belt)")
+    if fam.get("line_grid"):
+        g, p, n = fam["line_grid"]
+        why.append(f"every line of its comb stands on a dense grid the spectrum's own lines make ({n} lines on a "
+                   f"line every {g:.3f} Hz, p = {p:.1g}: a gearbox's hunting-tooth comb, two gears' tooth errors "
+                   f"repeating together), within {HUNT_TOL:g} of the spectrum's line spacing: the machine's lines, "
+                   "not the bearing's (declare the gear, with its ratio, to have them set apart)")
     if fam.get("hunting_comb"):
         why.append(f"every line of its comb stands on the gears' hunting-tooth comb (a line every "
                    f"{fam['hunting_comb']:.3f} Hz: the two gears' tooth errors repeat together), within "

@@ -164,19 +164,71 @@ def half_speed(ev, job, conf: float, reason: str) -> tuple[float, str]:
 
 
 def mesh_speed(run, conf: float, reason: str) -> tuple[float, str]:
-    """A declared gear whose mesh stands not at teeth x the declared speed but at twice or half that,
-    with a 1X at its speed (``speed._speed``: ``speed["mesh_factor"]``): the speed may be off by that
-    factor, and every order the answer rests on with it. A healthy 32/71 gearbox at 1800 rpm declared at
-    900 read its true 1X as 2X, "2X/1X = 10.4", and was called misalignment at 1.00: flag
-    ``speed_doubtful``, held at 0.45."""
+    """A declared gear whose mesh stands not at teeth x the declared speed but at 2, 0.5, 4 or 0.25 x
+    that (``speed.MESH_FACTORS``), with a 1X at its speed (``speed._speed``: ``speed["mesh_factor"]``),
+    or at half that as well as at it (the declared speed's line is then the mesh's second harmonic):
+    the speed, or the sampling rate, may be off by that factor, and every order the answer rests on with
+    it. A healthy 32/71 gearbox at 1800 rpm declared at 900 read its true 1X as 2X, "2X/1X = 10.4", and
+    was called misalignment at 1.00: flag ``speed_doubtful``, held at 0.45."""
     q = run.speed.get("mesh_factor")
     if q is None:
         return conf, reason
     job = run.job
+    also = " as well" if run.speed["mesh_hz"] != run.speed["mesh_factor_hz"] else ""
     return _held(job.flags, "speed_doubtful", f"the gear's mesh ({job.gear.teeth} teeth) stands at "
-                 f"{run.speed['mesh_hz']:.1f} Hz, {q:g} x where the declared {job.rpm:g} rpm puts it, with a 1X "
-                 f"at its speed: the speed may be {q:g} x the declared (rpm for Hz, pulses per revolution)",
+                 f"{run.speed['mesh_factor_hz']:.1f} Hz{also}, {q:g} x where the declared {job.rpm:g} rpm puts it, "
+                 f"with a 1X at its speed: the speed may be {q:g} x the declared, or fs {q:g} x (rpm for Hz, pulses per "
+                 "revolution, the sampling rate)",
                  conf, reason)
+
+
+def half_line(run, conf: float, reason: str) -> tuple[float, str]:
+    """A line at half the declared speed standing ``speed.HALF_OVER_1X_DB`` over the 1X (or where no 1X stands),
+    without the 1.5X that would make it a time base's mistake (``speed._speed``: ``speed["half_line"]``):
+    the shaft's true 1X may be that line, at a speed declared twice too high, and every order the answer
+    rests on is then read at twice its own. A loose machine's sub-harmonic stands under or about at its
+    1X. A healthy 23/67 gearbox at 2400 rpm declared at 4800 rpm showed its true 1X 28 dB over the
+    declared 1X (its true 2X), its 3X on the 120 Hz supply harmonic, and was called looseness at 1.00:
+    flag ``speed_doubtful``, held."""
+    half = run.speed.get("half_line")
+    if half is None:
+        return conf, reason
+    return _held(run.job.flags, "speed_doubtful", f"a line at {half[0]:.2f} Hz, half the declared {run.job.rpm:g} rpm, "
+                 f"stands {half[1]:.0f} dB over its floor, {half[1] - run.speed['one_x_db']:.0f} dB over the declared 1X's: it "
+                 "may be the shaft's 1X, at a speed half the declared (rpm for Hz, pulses per revolution), or "
+                 "a sub-harmonic: check the speed, or give tach=", conf, reason)
+
+
+def two_x_alone(run, top: str, conf: float, reason: str) -> tuple[float, str]:
+    """Misalignment called from its 2X where no 1X line stands at the declared speed (nor did a
+    tachometer measure it): the 2X is also the 1X of a shaft at twice the declared speed, the commonest
+    speed mistake (rpm for Hz, pulses per revolution), and "2X/1X" then compares a line with the noise.
+    A misaligned shaft keeps a 1X (its unbalance is never nil); which of the two it is, only the speed
+    can settle. A healthy 32/71 gearbox at 1800 rpm declared at 900 read 2X/1X = 10.4 and was called
+    misalignment at 1.00: flag ``speed_unconfirmed``, held."""
+    speed = run.speed
+    if top != "misalignment" or speed.get("estimated_rpm") is not None or speed.get("source") is not None:
+        return conf, reason
+    return _held(run.job.flags, "speed_unconfirmed", f"no 1X line stands at the declared {run.job.rpm:g} rpm: the "
+                 f"2X the call rests on is the 1X of a shaft at {2 * run.job.rpm:g} rpm if the speed was declared "
+                 "half the true one (rpm for Hz, pulses per revolution): check the speed, or give tach=", conf, reason)
+
+
+def gear_unseen(run, conf: float, reason: str) -> tuple[float, str]:
+    """A gear declared whose mesh line does not stand at teeth x the speed used (``gears.gear_rows``
+    sets the flag ``gear_not_seen``): the speed, the tooth count or the sensor's place is off, and the
+    gear was not checked: said, with the flag. Where no 1X confirmed the speed either, every order the
+    answer rests on is unconfirmed: held. A gearbox with a local tooth fault, declared at 0.8 x its speed
+    (beyond the mesh's search, then 12 %), read "none" at 0.73 unflagged. A speed a 1X confirms leaves
+    the rest of the answer standing (a fleet's every machine declared with a gear, the sensor on the
+    motor)."""
+    job = run.job
+    if "gear_not_seen" not in job.flags:
+        return conf, reason
+    hold = run.speed.get("estimated_rpm") is None
+    return _held(job.flags, "gear_not_seen", f"no mesh line stands at {job.gear.teeth} x the speed used "
+                 f"({job.gear.teeth * run.f1:.1f} Hz): the gear was not checked; check the speed, the tooth count "
+                 "and that the sensor sees the gear", conf, reason, hold=hold)
 
 
 def file_speed(run, conf: float, reason: str) -> tuple[float, str]:
@@ -265,14 +317,19 @@ def unit_label(job, severity: dict, conf: float, reason: str) -> tuple[float, st
 
 def hold_all(run, ev, severity: dict, top: str, conf: float, reason: str) -> tuple[float, str]:
     """Every doubt in turn: the time base, the unit, a speed the file contradicts, a gear's mesh at
-    twice or half the declared speed's, a speed nothing confirms, a factor 2 (half-harmonics, a rival
-    comb), a smeared ball at its slip's edge, the user's band. An answer that names no fault yet finds one likely ("undetermined", confidence 1 - p_healthy)
-    keeps its confidence: a doubt about the speed puts the fault's name in doubt, not its presence."""
+    2, 0.5, 4 or 0.25 x the declared speed's, a strong line at half it, a 2X called without a 1X, a gear
+    whose mesh is not seen, a speed nothing confirms, a factor 2 (half-harmonics, a rival comb), a smeared ball at its slip's edge, the
+    user's band. An answer that names no fault yet finds one likely ("undetermined", confidence
+    1 - p_healthy) keeps its confidence: a doubt about the speed puts the fault's name in doubt, not
+    its presence."""
     named = conf if top != "undetermined" else min(conf, DOUBT_CONFIDENCE)   # nothing to hold: none said
     named, reason = time_base(run.job, run.speed, severity, named, reason)
     named, reason = unit_label(run.job, severity, named, reason)
     named, reason = file_speed(run, named, reason)
     named, reason = mesh_speed(run, named, reason)
+    named, reason = half_line(run, named, reason)
+    named, reason = two_x_alone(run, top, named, reason)
+    named, reason = gear_unseen(run, named, reason)
     named, reason = unconfirmed_speed(run, named, reason)
     named, reason = half_speed(ev, run.job, named, reason)
     named, reason = factor_rival(run, ev, named, reason)

@@ -257,7 +257,8 @@ def gear_rows(run) -> list:
     shafts = [("this shaft", f1)]
     if gear.mating_shaft_ratio is not None:
         shafts.append(("the mating shaft", f1 * gear.mating_shaft_ratio))
-    if mesh_db < LINE_DB:
+    if mesh_db < LINE_DB:   # the answer then says the gear was not checked (``doubts.gear_unseen``)
+        run.job.flags.append("gear_not_seen")
         return [_row("gear_mesh", fm, mesh_f, mesh_amp, mesh_db, 0.0,
                      f"no mesh line at {gear.teeth} x 1X ({fm:.1f} Hz): the gear is not seen")]
     # the mesh line measures the speed: the places are set from it, as wide as the line itself is (a

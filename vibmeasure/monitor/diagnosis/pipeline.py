@@ -41,7 +41,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
 
     The steps (docs/methods/diagnosis.md): every channel checked for the recording chain's damage
     (spikes and dropouts filled, transients gated, saturation flagged); the running speed from the 1X
-    near ``rpm`` (within 12 %), checked against fs and against shaft or bearing combs that stand where
+    near ``rpm`` (within 12 %; a declared gear's mesh within 30 % with it), checked against fs and against shaft or bearing combs that stand where
     another speed puts them (flag ``speed_contradicted``: then no fault is looked for); the supply's
     lines set aside; the ISO 10816-3 severity; shaft-order faults weighed by the level; bearing
     families as a statistical test on pre-whitened squared-envelope spectra of every channel; the
@@ -177,7 +177,7 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
                    f"shows whether they matter cannot be computed (give unit=, e.g. 'g'); strongest pattern "
                    f"{unweighed[0]} at score {unweighed[1]:.2f}")
     if {"speed_inconsistent", "speed_contradicted", "order_tracked", "speed_varies",
-            "speed_corrected", "half_order_ambiguous"} & set(job.flags):
+            "speed_corrected", "half_order_ambiguous", "speed_unchecked"} & set(job.flags):
         reason += "; " + speed["note"]
     if narrow:
         reason += ("; " + ", ".join(f"{k} measures only up to {v:.0f} Hz" for k, v in narrow)
