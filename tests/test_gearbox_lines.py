@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import vibmeasure as vm
-from vibmeasure.monitor.bearing import evidence
+from vibmeasure.monitor.bearing import evidence, grid
 from vibmeasure.monitor.diagnosis import bearings
 
 
@@ -93,7 +93,7 @@ def test_a_bearing_comb_on_the_hunting_tooth_grid_is_not_called(monkeypatch):
     inner = d.faults.set_index("fault").loc["bearing_inner_race"]
     assert d.top != "bearing_inner_race" and inner.p_value < 1e-5
     assert "hunting-tooth comb (a line every 0.597 Hz" in inner.not_called
-    monkeypatch.setattr(evidence, "HUNT_TOL", 0.0)
+    monkeypatch.setattr(grid, "HUNT_TOL", 0.0)
     assert _diagnose(x, 2400, gear).top == "bearing_inner_race"
 
 

@@ -11,7 +11,7 @@ from ...core.errors import ParameterError
 from .cage import _cage_floor
 from .decoys import _decoy_p, _speed_scan
 from .families import HALVES, _accepted, _claim_artefact, _claim_shaft, _explain, _shaft_shows
-from .grid import line_grid
+from .grid import HUNT_TOL, measured_grid, on_grid
 from .lines import _log_p_to_conf
 from .rules import ALPHA, FAMILIES, MIN_VOTES, R_LINE, SAME_DATA, SINGLE_VIEW_P, SLIP
 from .smeared import _call_smeared, _smeared_ball
@@ -24,19 +24,6 @@ from .spectra import WHITENING, _fused, _spectra
 # factor / the mating gear's teeth)
 RACES = ("bearing_outer_race", "bearing_inner_race")
 RACE_DECOY_P = 0.05
-# Where both gears of a pair are declared (teeth and ratio), that hunting-tooth comb is known: a line
-# every f1 x gcd(z1, z2) / z2. Any line of it has lines of it at +-1X (z2 / gcd steps away), so a BPFI
-# +-1X triplet can stand on it at any frequency, and its lines' random heights reach p = 1e-12 among
-# thousands of such triplets (healthy gearboxes with rough gears, 20 % tooth errors: inner race at 0.99
-# for 23/67 at 2400 rpm, 0.68 for 32/71 at 1800, 0.58 for 40/83 at 3600). A comb every one
-# of whose standing lines (two or more), its frequency refined, lies within HUNT_TOL of a line of that
-# grid is the gearbox's, not the bearing's. A bearing's comb falls on the grid by chance only as often as
-# 2 HUNT_TOL over the grid's spacing in lines (at most 25 % for one carrier and its sidebands, where the
-# grid is HUNT_MIN_SPACING lines; a few per cent for two carriers); a finer grid holds every line and
-# is not tested. Measured on benchmarks/gearbox.py: no bearing fault under a two-gear mesh had every line
-# of its comb within 0.25 line of the grid; the four healthy gearboxes' above (seeds 4-7 of 3-8) did.
-HUNT_TOL = 0.25          # lines (bins)
-HUNT_MIN_SPACING = 2.0   # lines (bins)
 
 
 @dataclass(frozen=True)
@@ -151,7 +138,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     smeared = _smeared_if_none(fams, spectra, freqs, f1) if smeared_ball else None
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))
     confirmed = f1_known if speed_confirmed is None else speed_confirmed
-    other, rival = (None, None) if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed)
+    other, rival = (None, None) if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed,
+                                                                         hunting_hz)
     kurtogram = next((s.kurtogram for s in spectra if s.kurtogram is not None), None)
     return BearingEvidence(fams, spectra, kurtogram, len(spectra), measured, other, rival)
 
@@ -192,7 +180,7 @@ def _family_summaries(spectra, freqs, hunting_hz=None) -> tuple[dict, dict]:
     n_sp = len(spectra)
     votes = {name: [s for s in spectra if s.primary == name] for name in FAMILIES}
     n_views = _views(spectra)   # how many distinct views the record offers (one with a user's band= and channel)
-    fams, grids = {}, {}   # grids: each spectrum's measured line grid (``_measured_grid``), once
+    fams = {}
     for name in list(FAMILIES) + ["bearing_cage"]:
         key = "FTF" if name == "bearing_cage" else FAMILIES[name][0]
         pool = votes.get(name) or spectra
@@ -225,7 +213,7 @@ def _family_summaries(spectra, freqs, hunting_hz=None) -> tuple[dict, dict]:
             fams[name]["found"] = False
             fams[name]["hunting_comb"] = hunting_hz
         elif name in FAMILIES and fams[name]["found"] and hunting_hz is None:
-            grid = grids[id(where)] if id(where) in grids else grids.setdefault(id(where), _measured_grid(where, freqs))
+            grid = measured_grid(where, freqs["FTF"])
             if grid is not None and _on_hunting_grid(where, fams[name], grid[0]):
                 fams[name]["found"] = False
                 fams[name]["line_grid"] = grid
@@ -240,34 +228,10 @@ def _family_summaries(spectra, freqs, hunting_hz=None) -> tuple[dict, dict]:
     return fams, votes
 
 
-def _measured_grid(ses, freqs) -> tuple | None:
-    """A spectrum's dense line grid, measured (``grid.line_grid``): where no gear pair is declared, a
-    gearbox's hunting-tooth comb is found from its lines (healthy gearboxes declared without their gear,
-    under a user's band or a speed 0.8 x the true one, read as ball at 0.68-0.81 on it)."""
-    return line_grid(ses.freq, ses.r, ses.n_valid, ses.r_line, freqs["FTF"], HUNT_MIN_SPACING)
-
-
 def _on_hunting_grid(ses, fam: dict, spacing: float | None) -> bool:
-    """Whether every standing line of a family's comb (two or more), its frequency refined (a parabola
-    through the log power of its peak), lies within HUNT_TOL lines of the hunting-tooth grid."""
-    df = float(ses.freq[1])
-    if spacing is None or spacing < HUNT_MIN_SPACING * df:
-        return False
-    P = ses.amp[: ses.n_valid].astype(float) ** 2
-    standing = [ln["hz"] for ln in fam["lines"] if ln["r"] >= ses.r_line]
-    if len(standing) < 2:
-        return False
-    for hz in standing:
-        i = int(round(hz / df))
-        if not 2 <= i < P.size - 2:
-            return False
-        j = i - 1 + int(np.argmax(P[i - 1: i + 2]))
-        a, b, c = np.log(np.maximum(P[j - 1: j + 2], 1e-300))
-        den = a - 2 * b + c
-        fp = (j + (0.5 * (a - c) / den if den < 0 else 0.0)) * df
-        if abs(fp - round(fp / spacing) * spacing) > HUNT_TOL * df:
-            return False
-    return True
+    """Whether every standing line of a family's comb (two or more) lies on the hunting-tooth grid
+    (``grid.on_grid``)."""
+    return on_grid(ses, [ln["hz"] for ln in fam["lines"] if ln["r"] >= ses.r_line], spacing)
 
 
 def _smeared_if_none(fams, spectra, freqs, f1):

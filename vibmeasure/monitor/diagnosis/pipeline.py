@@ -23,6 +23,7 @@ from . import doubts
 from .decide import _decide, _unweighed, candidates
 from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note
 from .mains import supply_lines
+from .mating import mating_shaft
 from .severity import iso_severity
 from .gears import gear_rows
 from .shaft import gate_rows, shaft_rows
@@ -111,7 +112,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     rpm = tracked["mean_rpm"] if rpm is None and tracked is not None else rpm
     measured = _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band, prewhitening,
                         line_frequency, skip=_tach_channel(rec, tach))
-    run = running_speed(rec, measured, tracked, rpm, band)
+    run = mating_shaft(running_speed(rec, measured, tracked, rpm, band))
     supply = supply_lines(run)
     severity, gate = iso_severity(measured, run.job, supply)
     rows = shaft_rows(run, supply, gate, line_frequency)
@@ -182,6 +183,9 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     if narrow:
         reason += ("; " + ", ".join(f"{k} measures only up to {v:.0f} Hz" for k, v in narrow)
                    + " (above: a filter's stop band): the envelope bands reach down among the shaft harmonics")
+    if "mating_teeth" in speed:
+        reason += (f"; the mating gear's {speed['mating_teeth']} teeth measured from the mesh's sidebands (its "
+                   "shaft's lines set apart; declare mating_shaft_ratio= to fix it)")
     if job.converted:
         reason += "; " + _conversion_note(job.converted)
     if "channels_restricted" in job.flags:
