@@ -171,17 +171,24 @@ def test_a_measured_band_too_narrow_for_the_kurtogram_is_demodulated_whole():
     assert "band_limited" in d.flags
 
 
-def test_a_band_limited_gearboxs_wheel_orders_are_not_a_ball_fault():
+def test_a_band_limited_gearboxs_wheel_orders_are_not_a_ball_fault(monkeypatch):
     """The same band-limited gearbox, searched in its narrow band: the wheel's orders 15 and 30 (93.4,
     186.8 Hz) stand where the 6205's 2 x BSF and its double fall, p = 4e-6 to 5e-10, and were called ball
     at 1.00 with or without the gear's teeth. Two rules now hold it, each alone (checked by turning the
     other off): the wheel's other orders stand between them as high (a comb one in every 3 or 5 lines
     of a denser one), and a record that offers one view only gets no waiver of the two-view rule
-    (``test_bearing_faults.py::test_overwhelming_evidence_in_one_view_is_called``)."""
+    (``test_bearing_faults.py::test_overwhelming_evidence_in_one_view_is_called``). The wheel's teeth,
+    measured from the mesh's sidebands where only the pinion's are declared (``diagnosis.mating``), now
+    set its orders apart before either rule is asked: the rules are tested with that measurement off."""
+    from vibmeasure.monitor.diagnosis import mating
     warnings.simplefilter("ignore", vm.QualityWarning)
     for error in (0.05, 0.1):
         rec = _low_passed(_healthy_two_gear(1200, 19, 61, error, 30, 0))
         d = vm.diagnose(rec, rpm=1200, bearing="6205-2RS", gear=19)
+        assert d.speed.get("mating_teeth") == 61 and not _bearing_call(d)
+        monkeypatch.setattr(mating, "MATING_HITS", 99)
+        d = vm.diagnose(rec, rpm=1200, bearing="6205-2RS", gear=19)
+        monkeypatch.undo()
         ball = d.faults.set_index("fault").loc["bearing_ball"]
         assert not _bearing_call(d) and ball.p_value < 1e-5, d.reason
         assert "of a denser comb" in ball.not_called or "one view of the record only" in ball.not_called

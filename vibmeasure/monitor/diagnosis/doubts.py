@@ -217,18 +217,16 @@ def two_x_alone(run, top: str, conf: float, reason: str) -> tuple[float, str]:
 def gear_unseen(run, conf: float, reason: str) -> tuple[float, str]:
     """A gear declared whose mesh line does not stand at teeth x the speed used (``gears.gear_rows``
     sets the flag ``gear_not_seen``): the speed, the tooth count or the sensor's place is off, and the
-    gear was not checked: said, with the flag. Where no 1X confirmed the speed either, every order the
-    answer rests on is unconfirmed: held. A gearbox with a local tooth fault, declared at 0.8 x its speed
-    (beyond the mesh's search, then 12 %), read "none" at 0.73 unflagged. A speed a 1X confirms leaves
-    the rest of the answer standing (a fleet's every machine declared with a gear, the sensor on the
-    motor)."""
+    gear was not checked: said, with the flag, not held. A gearbox with a local tooth fault declared at
+    0.8 x its speed (its mesh then beyond the search) read "none" at 0.73 without a word; a fleet's every
+    machine declared with a gear, the sensor on the motor, or a 1X buried in noise beside it, leave the
+    rest of the answer standing."""
     job = run.job
     if "gear_not_seen" not in job.flags:
         return conf, reason
-    hold = run.speed.get("estimated_rpm") is None
     return _held(job.flags, "gear_not_seen", f"no mesh line stands at {job.gear.teeth} x the speed used "
                  f"({job.gear.teeth * run.f1:.1f} Hz): the gear was not checked; check the speed, the tooth count "
-                 "and that the sensor sees the gear", conf, reason, hold=hold)
+                 "and that the sensor sees the gear", conf, reason, hold=False)
 
 
 def file_speed(run, conf: float, reason: str) -> tuple[float, str]:

@@ -119,6 +119,32 @@ def _speed(job: Job, f, A):
             speed["note"] = (f"the 1X line is at {60 * f1:.0f} rpm, {100 * off:+.1f} % from the declared {job.rpm:g} "
                              "rpm: the measured speed is used")
             job.flags.append("speed_corrected")
+    _sub_orders(job, f, A, f1, snr1, speed)
+    if speed["consistent"] and not found:   # the declared speed is used as given: said, not held
+        speed["note"] = (f"no 1X line within {100 * SPEED_SEARCH:g} % of the declared {job.rpm:g} rpm: the speed "
+                         "is used as declared, unchecked")
+        job.flags.append("speed_unchecked")
+    # a speed the mesh and the 1X both measure is not contradicted by another shaft's comb (the mating
+    # shaft's, which every gearbox has)
+    other = _contradiction(job, f, A, found, snr1) if speed["consistent"] and not meshed else None
+    if other is not None:
+        _contradicted(job, speed, other, found)
+    if speed["consistent"]:
+        drift = _speed_drift(job.a, job.fs, f1)
+        if drift is not None and drift[2] > SPEED_DRIFT and drift[3] < DRIFT_P and _smeared(f, A, drift[0], drift[1]):
+            lo, hi, spread, _, coef = drift
+            speed.update(drift_hz=(lo, hi), _curve=coef, note=(
+                f"the 1X line moves between {lo:.2f} and {hi:.2f} Hz over the record ({100 * spread:.1f} %): the "
+                "speed varies and the bearing lines smear; give tach= or rpm_profile= for an analysis in orders"))
+            job.flags.append("speed_varies")   # the bearing side then says little (pipeline._bearing_weak)
+    return speed, f1
+
+
+def _sub_orders(job: Job, f, A, f1: float, snr1: float, speed: dict) -> None:
+    """Lines at quarter and half orders of the 1X (``speed`` updated, flags set): a time base that fits
+    only at 2 or 4 x fs (``speed_inconsistent``), a loose machine's sub-harmonics or a factor 2
+    (``half_order_ambiguous``), a 0.5X line alone far over the 1X (``speed["half_line"]``)."""
+    df = f[1]
     for r in (4, 2):
         # a mains line is no sub-harmonic (a 60 Hz line stood for 7/4 X of a 2100 rpm looseness machine)
         lines = [_line(f, A, k * f1 / r, max(2 * df, 0.01 * k * f1 / r), 0.5 * f1 / r) for k in range(1, 2 * r)
@@ -132,7 +158,7 @@ def _speed(job: Job, f, A):
                 f"lines at {1 / r:g}X, ... fit a shaft speed of {job.rpm:g} rpm only if fs is {r}x the declared "
                 f"{job.fs:g} Hz ({r * job.fs:g} Hz): check the sampling rate"))
             job.flags.append("speed_inconsistent")
-            break
+            return
         # a 0.5X line alone as far over the 1X (its 1.5X weak, or on a supply line): the shaft's 1X may be
         # that line all the same (``doubts.half_line``); a gearbox's tooth errors leave its 3X weak
         if r == 2 and hits[0] and not hits[1] and (snr1 < LINE_DB or lines[0][2] >= snr1 + HALF_OVER_1X_DB):
@@ -144,38 +170,26 @@ def _speed(job: Job, f, A):
                 f"the 0.5X and 1.5X lines stand within {-HALF_AMBIGUOUS_DB:g} dB of the 1X ({lines[0][2]:.1f} against "
                 f"{snr1:.1f} dB): a loose machine's sub-harmonics, or the true 1X of a record whose fs is 2x the "
                 f"declared {job.fs:g} Hz (or whose speed is half the declared {job.rpm:g} rpm): check both")) if x)
-    if speed["consistent"] and not found:   # the declared speed is used as given: said, not held
-        speed["note"] = (f"no 1X line within {100 * SPEED_SEARCH:g} % of the declared {job.rpm:g} rpm: the speed "
-                         "is used as declared, unchecked")
-        job.flags.append("speed_unchecked")
-    # a speed the mesh and the 1X both measure is not contradicted by another shaft's comb (the mating
-    # shaft's, which every gearbox has)
-    other = _contradiction(job, f, A, found, snr1) if speed["consistent"] and not meshed else None
-    if other is not None:
-        fc, h, db, where = other
-        near = (f"no line stands out within {100 * SPEED_SEARCH:g} % of the declared speed" if not found else
-                f"the best 1X candidate within {100 * SPEED_SEARCH:g} % of the declared speed ({60 * found[0]:.0f} "
-                f"rpm) stands only {found[1]:.0f} dB with {found[2]} of its harmonics")
-        speed.update(consistent=False, estimated_rpm=None, contradicting_rpm=60 * fc, note=(
-            f"the declared {job.rpm:g} rpm is contradicted by the spectrum of {where!r}: a shaft comb stands at "
-            f"{60 * fc:.0f} rpm "
-            f"({100 * (fc / (job.rpm / 60.0) - 1):+.1f} %; its line {db:.0f} dB above the floor with {h} of its "
-            f"harmonics 2X-6X), and {near}. Shaft-order and bearing "
-            "faults are not looked for at a speed the record contradicts: give the measured speed (rpm=, or "
-            "tach= / rpm_profile=)"))
-        speed.pop("one_x_harmonics", None)
-        if "speed_corrected" in job.flags:
-            job.flags.remove("speed_corrected")
-        job.flags.append("speed_contradicted")
-    if speed["consistent"]:
-        drift = _speed_drift(job.a, job.fs, f1)
-        if drift is not None and drift[2] > SPEED_DRIFT and drift[3] < DRIFT_P and _smeared(f, A, drift[0], drift[1]):
-            lo, hi, spread, _, coef = drift
-            speed.update(drift_hz=(lo, hi), _curve=coef, note=(
-                f"the 1X line moves between {lo:.2f} and {hi:.2f} Hz over the record ({100 * spread:.1f} %): the "
-                "speed varies and the bearing lines smear; give tach= or rpm_profile= for an analysis in orders"))
-            job.flags.append("speed_varies")   # the bearing side then says little (pipeline._bearing_weak)
-    return speed, f1
+
+
+def _contradicted(job: Job, speed: dict, other: tuple, found) -> None:
+    """The speed dict and flags where another shaft's comb (``_contradiction``: frequency, harmonics,
+    height, channel) contradicts the declared speed."""
+    fc, h, db, where = other
+    near = (f"no line stands out within {100 * SPEED_SEARCH:g} % of the declared speed" if not found else
+            f"the best 1X candidate within {100 * SPEED_SEARCH:g} % of the declared speed ({60 * found[0]:.0f} "
+            f"rpm) stands only {found[1]:.0f} dB with {found[2]} of its harmonics")
+    speed.update(consistent=False, estimated_rpm=None, contradicting_rpm=60 * fc, note=(
+        f"the declared {job.rpm:g} rpm is contradicted by the spectrum of {where!r}: a shaft comb stands at "
+        f"{60 * fc:.0f} rpm "
+        f"({100 * (fc / (job.rpm / 60.0) - 1):+.1f} %; its line {db:.0f} dB above the floor with {h} of its "
+        f"harmonics 2X-6X), and {near}. Shaft-order and bearing "
+        "faults are not looked for at a speed the record contradicts: give the measured speed (rpm=, or "
+        "tach= / rpm_profile=)"))
+    speed.pop("one_x_harmonics", None)
+    if "speed_corrected" in job.flags:
+        job.flags.remove("speed_corrected")
+    job.flags.append("speed_contradicted")
 
 
 # A declared speed further off than SPEED_SEARCH finds no 1X, or a wrong line, and puts the bearing
