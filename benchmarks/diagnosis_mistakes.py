@@ -148,37 +148,48 @@ def flagged(base, ans) -> bool:
 RECS = [r for r in records() if r[0] in ("cwru_fe", "mfpt")]
 
 
+KINDS = ("right", "not named", "wrong", "wrong, confident", "refused")
+
+
+def table(names, rows) -> list:
+    """Print, per mistake, how many answers are of each kind and how many are worse than the baseline
+    (wrong, or a right baseline answer lost) without a flag of their own; ``rows``: (mistake, label,
+    kind, the baseline's kind, baseline, answer). Returns the confident wrong and unflagged worse
+    answers, one line each."""
+    print(f"{'mistake':30s} {'n':>4} " + " ".join(f"{k:>16s}" for k in KINDS) + f" {'worse, unflagged':>17s}")
+    totals = dict.fromkeys(KINDS, 0)
+    bad = []
+    for m in names:
+        sel = [r for r in rows if r[0] == m]
+        counts = dict.fromkeys(KINDS, 0)
+        unflagged = 0
+        for _, label, k, base_kind, base, ans in sel:
+            counts[k] += 1
+            worse = k.startswith("wrong") or (base_kind == "right" and k != "right")
+            said = (f"{m}: {label} -> {ans.get('top')} {ans.get('confidence', 0):.2f} "
+                    f"(as recorded {base.get('top')} {base.get('confidence', 0):.2f})")
+            if worse and not flagged(base, ans):
+                unflagged += 1
+                bad.append(said + " unflagged")
+            elif k == "wrong, confident":
+                bad.append(said + f" flagged {sorted(set(ans['flags']) - set(base.get('flags', ())))}")
+        totals = {k: totals[k] + counts[k] for k in KINDS}
+        print(f"{m:30s} {len(sel):>4} " + " ".join(f"{counts[k]:>16d}" for k in KINDS) + f" {unflagged:>17d}",
+              flush=True)
+    print(f"{'all':30s} {len(rows):>4} " + " ".join(f"{totals[k]:>16d}" for k in KINDS))
+    return bad
+
+
 def main(names):
     jobs = [(i, m) for m in names for i, r in enumerate(RECS)
             if not (r[0] == "mfpt" and any(c in m for c in CWRU_ONLY))]
     t0 = time.perf_counter()
     with ProcessPoolExecutor(2) as pool:
         out = list(pool.map(one, jobs, chunksize=4))
-    kinds = ("right", "not named", "wrong", "wrong, confident", "refused")
     print(f"{len(jobs)} diagnoses in {time.perf_counter() - t0:.0f} s; development records: 45 CWRU fan-end "
           "(3 channels) + 8 MFPT (1 channel)\n")
-    print(f"{'mistake':30s} {'n':>4} " + " ".join(f"{k:>16s}" for k in kinds) + f" {'worse, unflagged':>17s}")
-    totals = dict.fromkeys(kinds, 0)
-    bad = []
-    for m in names:
-        rows = [o for o in out if o[0] == m]
-        counts = dict.fromkeys(kinds, 0)
-        unflagged = 0
-        for _, fname, truth, base, ans in rows:
-            k = judge(truth, base, ans)
-            counts[k] += 1
-            worse = k.startswith("wrong") or (judge(truth, base, base) == "right" and k != "right")
-            if worse and not flagged(base, ans):
-                unflagged += 1
-                bad.append(f"{m}: {fname} {truth} -> {ans.get('top')} {ans.get('confidence', 0):.2f} "
-                           f"(as recorded {base.get('top')})")
-            elif k == "wrong, confident":
-                bad.append(f"{m}: {fname} {truth} -> {ans['top']} {ans['confidence']:.2f} flagged "
-                           f"{sorted(set(ans['flags']) - set(base.get('flags', ())))}")
-        totals = {k: totals[k] + counts[k] for k in kinds}
-        print(f"{m:30s} {len(rows):>4} " + " ".join(f"{counts[k]:>16d}" for k in kinds) + f" {unflagged:>17d}",
-              flush=True)
-    print(f"{'all':30s} {len(out):>4} " + " ".join(f"{totals[k]:>16d}" for k in kinds))
+    bad = table(names, [(m, f"{fname} {truth}", judge(truth, base, ans), judge(truth, base, base), base, ans)
+                        for m, fname, truth, base, ans in out])
     print("\nconfident wrong answers, and worse answers without a flag of their own:")
     for b in bad:
         print("  " + b)

@@ -25,7 +25,7 @@ import warnings
 from concurrent.futures import ProcessPoolExecutor
 
 import vibmeasure as vm
-from diagnosis_mistakes import CWRU_ONLY, MISTAKES, NOT_NAMED, flagged
+from diagnosis_mistakes import CWRU_ONLY, MISTAKES, NOT_NAMED, table
 from gearbox import FS, DURATION, MORE_PAIRS, PAIRS
 
 ONE_CHANNEL = [m for m in MISTAKES if not any(c in m for c in CWRU_ONLY)]
@@ -97,31 +97,10 @@ def main():
     t0 = time.perf_counter()
     with ProcessPoolExecutor(2) as pool:
         out = [row for rows in pool.map(one, range(len(CASES))) for row in rows]
-    kinds = ("right", "not named", "wrong", "wrong, confident", "refused")
     print(f"{len(out)} diagnoses in {time.perf_counter() - t0:.0f} s; {len(CASES)} synthetic gearboxes, each with "
           "no gear and with the gear (teeth, ratio) declared\n")
-    print(f"{'mistake':30s} {'n':>4} " + " ".join(f"{k:>16s}" for k in kinds) + f" {'worse, unflagged':>17s}")
-    totals = dict.fromkeys(kinds, 0)
-    bad = []
-    for m in NAMES:
-        rows = [o for o in out if o[0] == m]
-        counts = dict.fromkeys(kinds, 0)
-        unflagged = 0
-        for _, label, declared, truth, base, ans in rows:
-            k = judge(truth, ans)
-            counts[k] += 1
-            worse = k.startswith("wrong") or (judge(truth, base) == "right" and k != "right")
-            said = (f"{m}: {label}, {declared}: -> {ans.get('top')} {ans.get('confidence', 0):.2f} "
-                    f"(as recorded {base.get('top')} {base.get('confidence', 0):.2f})")
-            if worse and not flagged(base, ans):
-                unflagged += 1
-                bad.append(said + " unflagged")
-            elif k == "wrong, confident":
-                bad.append(said + f" flagged {sorted(set(ans['flags']) - set(base.get('flags', ())))}")
-        totals = {k: totals[k] + counts[k] for k in kinds}
-        print(f"{m:30s} {len(rows):>4} " + " ".join(f"{counts[k]:>16d}" for k in kinds) + f" {unflagged:>17d}",
-              flush=True)
-    print(f"{'all':30s} {len(out):>4} " + " ".join(f"{totals[k]:>16d}" for k in kinds))
+    bad = table(NAMES, [(m, f"{label}, {declared}", judge(truth, ans), judge(truth, base), base, ans)
+                        for m, label, declared, truth, base, ans in out])
     base_right = sum(judge(o[3], o[4]) == "right" for o in out if o[0] == NAMES[0])
     print(f"\nas recorded: {base_right} of {2 * len(CASES)} right")
     print("\nconfident wrong answers, and worse answers without a flag of their own:")
