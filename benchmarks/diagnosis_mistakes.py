@@ -151,11 +151,11 @@ RECS = [r for r in records() if r[0] in ("cwru_fe", "mfpt")]
 KINDS = ("right", "not named", "wrong", "wrong, confident", "refused")
 
 
-def table(names, rows) -> list:
+def table(names, rows, note: str = "") -> None:
     """Print, per mistake, how many answers are of each kind and how many are worse than the baseline
-    (wrong, or a right baseline answer lost) without a flag of their own; ``rows``: (mistake, label,
-    kind, the baseline's kind, baseline, answer). Returns the confident wrong and unflagged worse
-    answers, one line each."""
+    (wrong, or a right baseline answer lost) without a flag of their own, then ``note`` and the
+    confident wrong and unflagged worse answers, one line each; ``rows``: (mistake, label, kind, the
+    baseline's kind, baseline, answer)."""
     print(f"{'mistake':30s} {'n':>4} " + " ".join(f"{k:>16s}" for k in KINDS) + f" {'worse, unflagged':>17s}")
     totals = dict.fromkeys(KINDS, 0)
     bad = []
@@ -176,8 +176,10 @@ def table(names, rows) -> list:
         totals = {k: totals[k] + counts[k] for k in KINDS}
         print(f"{m:30s} {len(sel):>4} " + " ".join(f"{counts[k]:>16d}" for k in KINDS) + f" {unflagged:>17d}",
               flush=True)
-    print(f"{'all':30s} {len(rows):>4} " + " ".join(f"{totals[k]:>16d}" for k in KINDS))
-    return bad
+    print(f"{'all':30s} {len(rows):>4} " + " ".join(f"{totals[k]:>16d}" for k in KINDS) + note)
+    print("\nconfident wrong answers, and worse answers without a flag of their own:")
+    for b in bad:
+        print("  " + b)
 
 
 def main(names):
@@ -188,11 +190,8 @@ def main(names):
         out = list(pool.map(one, jobs, chunksize=4))
     print(f"{len(jobs)} diagnoses in {time.perf_counter() - t0:.0f} s; development records: 45 CWRU fan-end "
           "(3 channels) + 8 MFPT (1 channel)\n")
-    bad = table(names, [(m, f"{fname} {truth}", judge(truth, base, ans), judge(truth, base, base), base, ans)
-                        for m, fname, truth, base, ans in out])
-    print("\nconfident wrong answers, and worse answers without a flag of their own:")
-    for b in bad:
-        print("  " + b)
+    table(names, [(m, f"{fname} {truth}", judge(truth, base, ans), judge(truth, base, base), base, ans)
+                  for m, fname, truth, base, ans in out])
 
 
 if __name__ == "__main__":

@@ -99,14 +99,10 @@ def main():
         out = [row for rows in pool.map(one, range(len(CASES))) for row in rows]
     print(f"{len(out)} diagnoses in {time.perf_counter() - t0:.0f} s; {len(CASES)} synthetic gearboxes, each with "
           "no gear and with the gear (teeth, ratio) declared\n")
-    bad = table(NAMES, [(m, f"{label}, {declared}", judge(truth, ans), judge(truth, base), base, ans)
-                        for m, label, declared, truth, base, ans in out])
     base_right = sum(judge(o[3], o[4]) == "right" for o in out if o[0] == NAMES[0])
-    print(f"\nas recorded: {base_right} of {2 * len(CASES)} right")
-    print("\nconfident wrong answers, and worse answers without a flag of their own:")
-    for b in bad:
-        print("  " + b)
-
+    table(NAMES, [(m, f"{label}, {declared}", judge(truth, ans), judge(truth, base), base, ans)
+                  for m, label, declared, truth, base, ans in out],
+          f"\n\nas recorded: {base_right} of {2 * len(CASES)} right")
 
 if __name__ == "__main__":
     args = sys.argv[1:]
