@@ -104,6 +104,7 @@ def main():
                   for m, label, declared, truth, base, ans in out],
           f"\n\nas recorded: {base_right} of {2 * len(CASES)} right")
 
+
 if __name__ == "__main__":
     args = sys.argv[1:]
     unknown = [a for a in args if a not in ONE_CHANNEL]
