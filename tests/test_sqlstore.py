@@ -514,3 +514,18 @@ def test_a_version_1_store_a_writer_may_not_alter_is_named_and_still_read(postgr
     assert time.monotonic() - t0 < 10.0
     with vm.Store(as_collector, raw_dir=tmp_path / "raw") as st:
         assert st.results("diagnose")["confidence"].tolist() == pytest.approx([0.5, 0.6])
+
+
+@pytest.mark.parametrize("name", ["plant.h5", "plant.db"])
+def test_an_empty_store_s_frames_keep_their_columns(tmp_path, name):
+    """A store whose writer was killed before its first measurement committed holds assets but no
+    measurement: ``measurements()["id"]`` is an empty column on both back-ends (the HDF5 store gave a
+    frame without columns, a KeyError on "id"), and so are the points of an asset without one."""
+    path = tmp_path / name
+    with vm.Store(path, writable=True) as st:
+        st.add_asset("pump-1")
+    st = vm.Store(path)
+    for frame in (st.measurements(), st.measurements(asset="pump-1", since="2026-01-01")):
+        assert frame.empty and {"id", "asset", "point", "time", "rpm", "file"} <= set(frame.columns)
+    assert st.measurements()["id"].tolist() == []
+    assert {"asset", "point", "channel", "unit"} <= set(st.points().columns)

@@ -17,6 +17,14 @@ ROW_SHAPE = {
     "results": {"measurement": str, "task": str, "summary": dict, "params": dict},
 }
 
+# the columns a table's frame has, also where it holds no row (a store whose first writer was killed
+# before its first measurement committed: ``measurements()["id"]`` must be an empty column, not a KeyError)
+COLUMNS = {
+    "assets": ("asset", "kind", "bearing", "gear", "model", "iso_group", "foundation", "meta"),
+    "points": ("asset", "point", "channel", "direction", "unit"),
+    "measurements": ("id", "asset", "point", "time", "rpm", "sha256", "file", "raw", "meta"),
+}
+
 
 def check_row(table: str, row, src: str) -> dict:
     """``row`` if it has its table's keys with their types, else a ParameterError naming the first misfit."""

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..core.errors import ParameterError
 from ..core._validate import check_flag
-from ._store_common import ALARM_COLUMNS, TASK_ALIASES, _hash_key, _seconds, check_row
+from ._store_common import ALARM_COLUMNS, COLUMNS, TASK_ALIASES, _hash_key, _seconds, check_row
 
 
 class _Queries:
@@ -42,7 +42,7 @@ class _Queries:
             rows = list(self._points.values())
         else:
             rows = list(self._each(table))
-        df = pd.DataFrame(rows)
+        df = pd.DataFrame(rows) if rows else pd.DataFrame(columns=list(COLUMNS[table]))
         for k, v in filters.items():
             if v is not None and k in df:
                 df = df[df[k] == v]
