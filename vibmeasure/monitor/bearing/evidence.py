@@ -107,7 +107,9 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
         where a bearing line could stand, since whichever speed is true they are a shaft's lines.
     hunting_hz : float, optional
         The spacing (Hz) of a gear pair's hunting-tooth comb (f1 x gcd(z1, z2) / z2): a family whose
-        standing lines all lie on it is not found (HUNT_TOL).
+        standing lines all lie on it is not found (HUNT_TOL), nor does a comb on it at another speed
+        contradict f1. Without it, a dense grid measured from each spectrum's lines
+        (``grid.line_grid``) stands in.
 
     Returns
     -------
