@@ -7,7 +7,6 @@ import numpy as np
 
 from .families import _family
 from .families import HALVES
-from .grid import measured_grid, on_grid
 from .lines import _best, _comb_logps, _halves, _positions, _step
 from .rules import ALPHA, FAMILIES, SLIP
 from .spectra import _SES
@@ -128,8 +127,7 @@ def _declared(hz: list, freqs: dict, df: float) -> bool:
                                 for f in (freqs["BPFO"], freqs["BPFI"], freqs["BSF"], freqs["2xBSF"])) for h in hz)
 
 
-def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, confirmed: bool = False,
-                hunting_hz: float | None = None) -> tuple:
+def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, confirmed: bool = False) -> tuple:
     """(contradiction, rival). The contradiction: the bearing comb that contradicts the declared speed
     (see SPEED_SCAN; where a 1X ``confirmed`` the speed, only within FACTOR_WINDOWS), or None. The
     rival: the best significant comb within FACTOR_WINDOWS when it does not contradict the speed yet is
@@ -140,9 +138,7 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
     shaft's and the cage's claims (``r_base``), every family at the declared speed (its +-SLIP, and
     scaled anywhere within ``speed_search``) against every family elsewhere. A comb elsewhere whose lines are all harmonics of a speed within
     ``speed_search`` of the declared one is that shaft's modulation (a 1X too weak to be found), not a
-    bearing's; one whose lines all stand on a gearbox's hunting-tooth grid (``hunting_hz``, or the
-    spectrum's measured dense grid: ``grid``) is the gearbox's (a healthy 32/71 gearbox at its declared
-    1800 rpm had its speed contradicted by an outer race comb at 1584 rpm on that grid)."""
+    bearing's."""
     n_sp = max(1, len(spectra))
     found, declared = [], 0.0
     ranges = FACTOR_WINDOWS if confirmed else (SPEED_SCAN,) + FACTOR_WINDOWS
@@ -172,7 +168,7 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
                         continue
                     c = _scanned(res, ses, freqs, key, harmonics, side, sp, f1, speed_search,
                                  np.log(len(models)) + np.log(n_sp), (lo, hi) in FACTOR_WINDOWS)
-                    if c is not None and not _on_grid(ses, c[1], freqs, hunting_hz):
+                    if c is not None:
                         found.append((c[0], dict(c[1], family=name, factor_window=(lo, hi) in FACTOR_WINDOWS)))
     if not found:
         return None, None
@@ -190,16 +186,6 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
             others.append(c["factor"])
     best["other_factors"] = others
     return best, None
-
-
-def _on_grid(ses, comb: dict, freqs: dict, hunting_hz: float | None) -> bool:
-    """Whether a scanned comb's standing lines all lie on the gearbox's hunting-tooth grid: the declared
-    gear pair's, else the spectrum's measured one (``grid.measured_grid``)."""
-    spacing = hunting_hz
-    if spacing is None:
-        measured = measured_grid(ses, freqs["FTF"])
-        spacing = None if measured is None else measured[0]
-    return on_grid(ses, [hz for hz, _ in comb["lines"]], spacing)
 
 
 def _rival(found: list, declared: float) -> dict | None:

@@ -11,7 +11,7 @@ from ...core.errors import ParameterError
 from .cage import _cage_floor
 from .decoys import _decoy_p, _speed_scan
 from .families import HALVES, _accepted, _claim_artefact, _claim_shaft, _explain, _shaft_shows
-from .grid import HUNT_TOL, measured_grid, on_grid
+from .grid import HUNT_TOL, on_grid
 from .lines import _log_p_to_conf
 from .rules import ALPHA, FAMILIES, MIN_VOTES, R_LINE, SAME_DATA, SINGLE_VIEW_P, SLIP
 from .smeared import _call_smeared, _smeared_ball
@@ -107,9 +107,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
         where a bearing line could stand, since whichever speed is true they are a shaft's lines.
     hunting_hz : float, optional
         The spacing (Hz) of a gear pair's hunting-tooth comb (f1 x gcd(z1, z2) / z2): a family whose
-        standing lines all lie on it is not found (HUNT_TOL), nor does a comb on it at another speed
-        contradict f1. Without it, a dense grid measured from each spectrum's lines
-        (``grid.line_grid``) stands in.
+        standing lines all lie on it is not found (HUNT_TOL).
 
     Returns
     -------
@@ -140,8 +138,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     smeared = _smeared_if_none(fams, spectra, freqs, f1) if smeared_ball else None
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))
     confirmed = f1_known if speed_confirmed is None else speed_confirmed
-    other, rival = (None, None) if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed,
-                                                                         hunting_hz)
+    other, rival = (None, None) if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed)
     kurtogram = next((s.kurtogram for s in spectra if s.kurtogram is not None), None)
     return BearingEvidence(fams, spectra, kurtogram, len(spectra), measured, other, rival)
 
@@ -214,11 +211,6 @@ def _family_summaries(spectra, freqs, hunting_hz=None) -> tuple[dict, dict]:
         elif name in FAMILIES and fams[name]["found"] and _on_hunting_grid(where, fams[name], hunting_hz):
             fams[name]["found"] = False
             fams[name]["hunting_comb"] = hunting_hz
-        elif name in FAMILIES and fams[name]["found"] and hunting_hz is None:
-            grid = measured_grid(where, freqs["FTF"])
-            if grid is not None and _on_hunting_grid(where, fams[name], grid[0]):
-                fams[name]["found"] = False
-                fams[name]["line_grid"] = grid
     # a family only the user's band claims is no call against one the record's own bands call: a band
     # that misses the bearing's resonance demodulates clutter (CWRU fan-end OR007@3_1, outer race at 1.00
     # in its own bands, read as ball in 300-900 Hz and inner race in 4.2-5.4 kHz)
@@ -375,12 +367,6 @@ def _not_called(name: str, fam: dict, n_sp: int, n_views: int) -> str | None:
         why.append(f"its spectrum makes such combs by chance: {100 * fam['decoy_p']:.0f} % of decoy combs at "
                    f"fundamentals that are no bearing frequency score as well (a race's comb needs at most "
                    f"{100 * RACE_DECOY_P:g} %): a dense line spectrum (two gears' hunting-tooth rate, a belt)")
-    if fam.get("line_grid"):
-        g, p, n = fam["line_grid"]
-        why.append(f"every line of its comb stands on a dense grid the spectrum's own lines make ({n} lines on a "
-                   f"line every {g:.3f} Hz, p = {p:.1g}: a gearbox's hunting-tooth comb, two gears' tooth errors "
-                   f"repeating together), within {HUNT_TOL:g} of the spectrum's line spacing: the machine's lines, "
-                   "not the bearing's (declare the gear, with its ratio, to have them set apart)")
     if fam.get("hunting_comb"):
         why.append(f"every line of its comb stands on the gears' hunting-tooth comb (a line every "
                    f"{fam['hunting_comb']:.3f} Hz: the two gears' tooth errors repeat together), within "
