@@ -183,8 +183,8 @@ def mesh_speed(run, conf: float, reason: str) -> tuple[float, str]:
 
 
 def half_line(run, conf: float, reason: str) -> tuple[float, str]:
-    """A line at half the declared speed standing ``speed.HALF_OVER_1X_DB`` over the 1X (or where no 1X stands),
-    without the 1.5X that would make it a time base's mistake (``speed._speed``: ``speed["half_line"]``):
+    """A line at half the declared speed standing ``speed.HALF_OVER_1X_DB`` over the 1X (or where no 1X
+    stands), without the 1.5X that would make it a time base's mistake (``speed._speed``: ``speed["half_line"]``):
     the shaft's true 1X may be that line, at a speed declared twice too high, and every order the answer
     rests on is then read at twice its own. A loose machine's sub-harmonic stands under or about at its
     1X. A healthy 23/67 gearbox at 2400 rpm declared at 4800 rpm showed its true 1X 28 dB over the
@@ -314,12 +314,12 @@ def unit_label(job, severity: dict, conf: float, reason: str) -> tuple[float, st
 
 
 def hold_all(run, ev, severity: dict, top: str, conf: float, reason: str) -> tuple[float, str]:
-    """Every doubt in turn: the time base, the unit, a speed the file contradicts, a gear's mesh at
-    2, 0.5, 4 or 0.25 x the declared speed's, a strong line at half it, a 2X called without a 1X, a gear
-    whose mesh is not seen, a speed nothing confirms, a factor 2 (half-harmonics, a rival comb), a smeared ball at its slip's edge, the
-    user's band. An answer that names no fault yet finds one likely ("undetermined", confidence
-    1 - p_healthy) keeps its confidence: a doubt about the speed puts the fault's name in doubt, not
-    its presence."""
+    """Every doubt in turn: the time base, the unit, a speed the file contradicts, a gear's mesh at 2,
+    0.5, 4 or 0.25 x the declared speed's, a strong line at half it, a 2X called without a 1X, a gear
+    whose mesh is not seen, a speed nothing confirms, a factor 2 (half-harmonics, a rival comb), a
+    smeared ball at its slip's edge, the user's band. An answer that names no fault yet finds one likely
+    ("undetermined", confidence 1 - p_healthy) keeps its confidence: a doubt about the speed puts the
+    fault's name in doubt, not its presence."""
     named = conf if top != "undetermined" else min(conf, DOUBT_CONFIDENCE)   # nothing to hold: none said
     named, reason = time_base(run.job, run.speed, severity, named, reason)
     named, reason = unit_label(run.job, severity, named, reason)

@@ -42,12 +42,13 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
 
     The steps (docs/methods/diagnosis.md): every channel checked for the recording chain's damage
     (spikes and dropouts filled, transients gated, saturation flagged); the running speed from the 1X
-    near ``rpm`` (within 12 %; a declared gear's mesh within 30 % with it), checked against fs and against shaft or bearing combs that stand where
-    another speed puts them (flag ``speed_contradicted``: then no fault is looked for); the supply's
-    lines set aside; the ISO 10816-3 severity; shaft-order faults weighed by the level; bearing
-    families as a statistical test on pre-whitened squared-envelope spectra of every channel; the
-    decision with a calibrated confidence and its reason. A speed that varies (``tach``,
-    ``rpm_profile``, or a 1X that drifts) is followed by order tracking (flag ``order_tracked``).
+    near ``rpm`` (within 12 %; a declared gear's mesh within 30 % with it), checked against fs and
+    against shaft or bearing combs that stand where another speed puts them (flag
+    ``speed_contradicted``: then no fault is looked for); the supply's lines set aside; the ISO 10816-3
+    severity; shaft-order faults weighed by the level; bearing families as a statistical test on
+    pre-whitened squared-envelope spectra of every channel; the decision with a calibrated confidence
+    and its reason. A speed that varies (``tach``, ``rpm_profile``, or a 1X that drifts) is followed by
+    order tracking (flag ``order_tracked``).
 
     Parameters
     ----------
