@@ -77,15 +77,21 @@ def test_a_healthy_two_gear_gearbox_is_no_gear_fault(case):
 
 
 @pytest.mark.parametrize("case", [(1800, 32, 71, 0.1, 10, 0), (1797, 32, 71, 0.05, 30, 1)])
-def test_a_second_shafts_comb_is_not_taken_for_a_bearings(case):
+def test_a_second_shafts_comb_is_not_taken_for_a_bearings(case, monkeypatch):
     """A healthy 32/71 gearbox: the wheel's orders 8, 16, 24 ... stand 0.6 % off the 6205's BPFO and its
     harmonics (13.5 Hz x 8 = 108.2 Hz at 1800 rpm), with the seven orders between each standing too. With
-    no gear declared, these records were called inner race at 0.86 and outer race at 0.74. A comb that
-    is every m-th line of a denser one (m 3..12, its own +-1X sidebands aside) is not called; the
-    genuine faults of the same gearbox still are (below). The refusal says how to have the other shaft's
-    harmonics claimed: declare it (``Gear(teeth, mating_shaft_ratio=)``)."""
+    no gear declared, these records were called inner race at 0.86 and outer race at 0.74. The gear pair
+    is found from the mesh's sidebands (``gearbox``: 32 and 71 teeth) and the wheel's harmonics are
+    claimed; where no pair is found (the search turned off here), a comb that is every m-th line of a
+    denser one (m 3..12, its own +-1X sidebands aside) is not called, and the refusal says how to have
+    the other shaft's harmonics claimed: declare it (``Gear(teeth, mating_shaft_ratio=)``)."""
+    from vibmeasure.monitor.diagnosis import gearbox
     warnings.simplefilter("ignore", vm.QualityWarning)
     rpm, teeth, mating, error, snr, seed = case
+    d = vm.diagnose(_healthy_two_gear(*case), rpm=rpm, bearing="6205-2RS")
+    assert not _bearing_call(d), d.reason
+    assert d.speed["gearbox"]["teeth"] == (teeth, mating) and "its mate (71 teeth" in d.reason, d.reason
+    monkeypatch.setattr(gearbox, "find_gearbox", lambda f, A, f1: None)
     d = vm.diagnose(_healthy_two_gear(*case), rpm=rpm, bearing="6205-2RS")
     assert not _bearing_call(d), d.reason
     outer = d.faults.set_index("fault").loc["bearing_outer_race", "not_called"]
@@ -106,15 +112,20 @@ def test_the_declared_mating_shafts_harmonics_are_claimed(case):
 
 
 @pytest.mark.parametrize("case", [(1797, 32, 71, 0.1, 30, 2, True), (2400, 23, 67, 0.05, 30, 2, False)])
-def test_a_two_shaft_comb_that_fits_a_bearing_only_at_the_slip_edge_is_not_called(case):
+def test_a_two_shaft_comb_that_fits_a_bearing_only_at_the_slip_edge_is_not_called(case, monkeypatch):
     """Lines of the two shafts' orders combined (129.0, 317.9, 506.8 Hz: 14 x 13.50 Hz apart, 2 x 29.95 Hz
     below) fit the 6205's BPFI +-1X at -1.98 % slip, one grid point (half a bin) inside the +-2 % range;
     on the 23/67 gearbox, 192.2 and 288.3 Hz fit 2 x BSF x 1, 1.5 at +1.94 %. A placement less than a bin
     from the edge reads the lines the edge placement reads, so the comb would fit as well further off:
-    these were called inner race at 0.67 and ball at 1.00."""
+    these were called inner race at 0.67 and ball at 1.00. (With no gear declared, the pair the mesh's
+    sidebands show is set apart first: ``gearbox``, turned off here for the slip-edge rule.)"""
+    from vibmeasure.monitor.diagnosis import gearbox
     warnings.simplefilter("ignore", vm.QualityWarning)
     rpm, teeth, mating, error, snr, seed, ratio = case
     gear = vm.Gear(teeth, mating_shaft_ratio=teeth / mating) if ratio else None
+    d = vm.diagnose(_healthy_two_gear(*case[:6]), rpm=rpm, bearing="6205-2RS", gear=gear)
+    assert not _bearing_call(d), d.reason
+    monkeypatch.setattr(gearbox, "find_gearbox", lambda f, A, f1: None)
     d = vm.diagnose(_healthy_two_gear(*case[:6]), rpm=rpm, bearing="6205-2RS", gear=gear)
     assert not _bearing_call(d), d.reason
     fault = "bearing_inner_race" if ratio else "bearing_ball"

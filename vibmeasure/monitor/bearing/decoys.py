@@ -7,6 +7,7 @@ import numpy as np
 
 from .families import _family
 from .families import HALVES
+from .grid import on_grid
 from .lines import _best, _comb_logps, _halves, _positions, _step
 from .rules import ALPHA, FAMILIES, SLIP
 from .spectra import _SES
@@ -127,7 +128,8 @@ def _declared(hz: list, freqs: dict, df: float) -> bool:
                                 for f in (freqs["BPFO"], freqs["BPFI"], freqs["BSF"], freqs["2xBSF"])) for h in hz)
 
 
-def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, confirmed: bool = False) -> tuple:
+def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, confirmed: bool = False,
+                hunting_hz: float | None = None) -> tuple:
     """(contradiction, rival). The contradiction: the bearing comb that contradicts the declared speed
     (see SPEED_SCAN; where a 1X ``confirmed`` the speed, only within FACTOR_WINDOWS), or None. The
     rival: the best significant comb within FACTOR_WINDOWS when it does not contradict the speed yet is
@@ -168,7 +170,7 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
                         continue
                     c = _scanned(res, ses, freqs, key, harmonics, side, sp, f1, speed_search,
                                  np.log(len(models)) + np.log(n_sp), (lo, hi) in FACTOR_WINDOWS)
-                    if c is not None:
+                    if c is not None and not on_grid(ses, [hz for hz, _ in c[1]["lines"]], hunting_hz):
                         found.append((c[0], dict(c[1], family=name, factor_window=(lo, hi) in FACTOR_WINDOWS)))
     if not found:
         return None, None

@@ -138,7 +138,8 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     smeared = _smeared_if_none(fams, spectra, freqs, f1) if smeared_ball else None
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))
     confirmed = f1_known if speed_confirmed is None else speed_confirmed
-    other, rival = (None, None) if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed)
+    other, rival = (None, None) if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed,
+                                                                           hunting_hz)
     kurtogram = next((s.kurtogram for s in spectra if s.kurtogram is not None), None)
     return BearingEvidence(fams, spectra, kurtogram, len(spectra), measured, other, rival)
 

@@ -212,15 +212,24 @@ def _diagnosable(job: Job, hz: float) -> bool:
 
 
 def _other_shafts(job: Job, shaft: float) -> tuple:
-    """The mating shaft's speed where a gear with its ratio is given (its harmonics are claimed)."""
-    gear = job.gear
+    """The mating shaft's speed where a gear with its ratio is given (at ``shaft`` Hz) or found (as measured:
+    ``gearbox``): its harmonics are claimed."""
+    gear, shaft = _gear_at(job, shaft)
     return () if gear is None or gear.mating_shaft_ratio is None else (shaft * gear.mating_shaft_ratio,)
+
+
+def _gear_at(job: Job, shaft: float) -> tuple:
+    """(gear, its shaft's Hz): the declared gear at ``shaft``, or the pair found at its measured speed
+    (the mesh fixes both shafts whatever speed a bearing test supposes), or (None, shaft)."""
+    if job.gear is None and job.found_gear is not None:
+        return job.found_gear
+    return job.gear, shaft
 
 
 def _hunting(job: Job, shaft: float) -> float | None:
     """The spacing of the gear pair's hunting-tooth comb, shaft x gcd(z1, z2) / z2, where the gear is
-    given with a ratio that makes a whole number of teeth on the mating gear."""
-    gear = job.gear
+    given (or found: ``gearbox``) with a ratio that makes a whole number of teeth on the mating gear."""
+    gear, shaft = _gear_at(job, shaft)
     if gear is None or gear.mating_shaft_ratio is None:
         return None
     z2 = gear.teeth / gear.mating_shaft_ratio

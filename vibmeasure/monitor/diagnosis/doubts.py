@@ -182,6 +182,31 @@ def mesh_speed(run, conf: float, reason: str) -> tuple[float, str]:
                  conf, reason)
 
 
+def gearbox_speed(run, conf: float, reason: str) -> tuple[float, str]:
+    """A gear pair found in the spectrum, none declared (``gearbox.gearbox_found``: ``speed["gearbox"]``),
+    neither of whose shafts turns at the speed used, where no 1X with its harmonics confirms that speed:
+    the mesh measures both shafts teeth times finer than a 1X, so the speed (or fs) may be off, by a
+    factor where one shaft stands at 2, 0.5, 4 or 0.25 x the declared speed, and every order the answer
+    rests on with it. A healthy 32/71 gearbox declared at 0.8 x its speed called a ball at 0.68, read
+    at 4 x its fs an outer race at 1.00: flag ``speed_doubtful``, held. Where a 1X with its harmonics
+    confirms the speed, the pair is another stage's: said, not held."""
+    info = run.speed.get("gearbox")
+    if not info or info.get("on_shaft"):
+        return conf, reason
+    job = run.job
+    (za, zb), (ra, rb) = info["teeth"], info["shafts_rpm"]
+    what = (f"a gear mesh stands at {info['mesh_hz']:.1f} Hz with the sidebands of two shafts, {ra:.0f} rpm ({za} "
+            f"teeth) and {rb:.0f} rpm ({zb} teeth), neither at the {60 * run.f1:.0f} rpm used")
+    if info["confirmed"]:
+        return _held(job.flags, "gear_elsewhere", what + ", whose 1X and harmonics stand: another stage's pair",
+                     conf, reason, hold=False)
+    q = info.get("factor")
+    why = (f": the speed may be {q:g} x the declared (rpm for Hz, pulses per revolution) or fs {q:g} x" if q else
+           ": the speed may be off")
+    return _held(job.flags, "speed_doubtful", what + why + "; check the speed and fs, or give tach= (or declare "
+                 "gear= for the shaft the sensor is on)", conf, reason)
+
+
 def half_line(run, conf: float, reason: str) -> tuple[float, str]:
     """A line at half the declared speed standing ``speed.HALF_OVER_1X_DB`` over the 1X (or where no 1X
     stands), without the 1.5X that would make it a time base's mistake (``speed._speed``: ``speed["half_line"]``):
@@ -315,7 +340,7 @@ def unit_label(job, severity: dict, conf: float, reason: str) -> tuple[float, st
 
 def hold_all(run, ev, severity: dict, top: str, conf: float, reason: str) -> tuple[float, str]:
     """Every doubt in turn: the time base, the unit, a speed the file contradicts, a gear's mesh at 2,
-    0.5, 4 or 0.25 x the declared speed's, a strong line at half it, a 2X called without a 1X, a gear
+    0.5, 4 or 0.25 x the declared speed's, a gear pair found whose shafts are not the speed used, a strong line at half it, a 2X called without a 1X, a gear
     whose mesh is not seen, a speed nothing confirms, a factor 2 (half-harmonics, a rival comb), a
     smeared ball at its slip's edge, the user's band. An answer that names no fault yet finds one likely
     ("undetermined", confidence 1 - p_healthy) keeps its confidence: a doubt about the speed puts the
@@ -325,6 +350,7 @@ def hold_all(run, ev, severity: dict, top: str, conf: float, reason: str) -> tup
     named, reason = unit_label(run.job, severity, named, reason)
     named, reason = file_speed(run, named, reason)
     named, reason = mesh_speed(run, named, reason)
+    named, reason = gearbox_speed(run, named, reason)
     named, reason = half_line(run, named, reason)
     named, reason = two_x_alone(run, top, named, reason)
     named, reason = gear_unseen(run, named, reason)

@@ -43,6 +43,7 @@ class Job:
     file_rpm: float | None = None   # the speed the file states, when a declared rpm overrides it
     at_other_speeds: list = field(default_factory=list)  # {rpm, why, where, found: {family: p}} per speed tried
     unit_share: float | None = None  # a velocity/displacement label's high-band share (``_unit_plausibility``)
+    found_gear: tuple | None = None  # (Gear, its shaft's Hz): a pair the spectrum shows, none declared (``gearbox``)
 
 
 # --- prepare ---------------------------------------------------------------------------------------

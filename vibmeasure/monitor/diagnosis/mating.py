@@ -30,10 +30,10 @@ MATING_HITS = 10
 MATING_MARGIN = 3
 
 
-def _standing_at(f, A, hz: np.ndarray) -> np.ndarray:
-    """For each frequency in hz, whether a local peak at most a line away stands LINE_DB over its floor
-    (the median of the bins 6 to 60 lines either side) within MATING_TOL of it, its frequency refined
-    by a parabola through its log peak."""
+def place_db(f, A, hz: np.ndarray) -> np.ndarray:
+    """For each frequency in hz, the height (dB over its floor, the median of the bins 6 to 60 lines
+    either side) of the local peak at most a line away, where it stands LINE_DB and lies within
+    MATING_TOL of it (its frequency refined by a parabola through its log peak); 0 elsewhere."""
     df, n = f[1], A.size
     i = np.rint(hz / df).astype(int)
     ok = (i >= 61) & (i < n - 61)
@@ -45,7 +45,14 @@ def _standing_at(f, A, hz: np.ndarray) -> np.ndarray:
     ring = np.concatenate([np.arange(-60, -5), np.arange(6, 61)])
     floor = np.median(A[j[:, None] + ring[None, :]], axis=1)
     db = 20 * np.log10(np.maximum(A[j], 1e-300) / np.maximum(floor, 1e-300))
-    return ok & (db >= LINE_DB) & (np.abs(fp - hz) <= MATING_TOL * df)
+    return np.where(ok & (db >= LINE_DB) & (np.abs(fp - hz) <= MATING_TOL * df), db, 0.0)
+
+
+def places(mesh_hz: float, s: np.ndarray) -> np.ndarray:
+    """The 14 places (counts, 14) a shaft at each speed s puts lines at beside a mesh at ``mesh_hz``:
+    its 1X and 2X, and sidebands at +-1..3 x s around the mesh's first and second harmonics."""
+    offsets = [(0.0, 1.0), (0.0, 2.0)] + [(h * mesh_hz, q) for h in (1, 2) for q in (-3, -2, -1, 1, 2, 3)]
+    return np.stack([base + q * s for base, q in offsets], axis=1)
 
 
 def mating_teeth(f, A, mesh_hz: float, teeth: int) -> int | None:
@@ -61,9 +68,8 @@ def mating_teeth(f, A, mesh_hz: float, teeth: int) -> int | None:
     z2, s = z2[~own], s[~own]
     if z2.size < 2:
         return None
-    offsets = [(0.0, 1.0), (0.0, 2.0)] + [(h * mesh_hz, q) for h in (1, 2) for q in (-3, -2, -1, 1, 2, 3)]
-    places = np.stack([base + q * s for base, q in offsets], axis=1)   # (counts, 14)
-    hits = _standing_at(f, A, places.ravel()).reshape(places.shape).sum(axis=1)
+    at = places(mesh_hz, s)
+    hits = (place_db(f, A, at.ravel()).reshape(at.shape) > 0).sum(axis=1)
     order = np.argsort(-hits, kind="stable")
     best, second = hits[order[0]], hits[order[1]]
     return int(z2[order[0]]) if best >= MATING_HITS and best - second >= MATING_MARGIN else None

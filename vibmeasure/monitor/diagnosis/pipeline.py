@@ -1,7 +1,8 @@
 """Machine fault diagnosis from accelerometer records, read as its steps (one module each):
 
 prepare (``job``: channels, units, damage, bearing, limits) -> running speed (``speed``, ``tracking``:
-the 1X, its consistency with fs, order tracking) -> the supply's lines (``mains``) -> ISO 10816-3
+the 1X, its consistency with fs, order tracking) -> the gear pair's shafts (``mating``: a declared gear's
+mate; ``gearbox``: a pair the spectrum shows where none is declared) -> the supply's lines (``mains``) -> ISO 10816-3
 severity (``severity``) -> shaft-order faults (``shaft``: gated by severity) -> bearing families
 (``bearings``: the statistical test of monitor/bearing on every channel, never gated by severity;
 again at the file's own speed where it disputes the declared one)
@@ -23,6 +24,7 @@ from . import doubts
 from .decide import _decide, _unweighed, candidates
 from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note
 from .mains import supply_lines
+from .gearbox import found_note, gearbox_found
 from .mating import mating_shaft
 from .severity import iso_severity
 from .gears import gear_rows
@@ -113,7 +115,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     rpm = tracked["mean_rpm"] if rpm is None and tracked is not None else rpm
     measured = _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band, prewhitening,
                         line_frequency, skip=_tach_channel(rec, tach))
-    run = mating_shaft(running_speed(rec, measured, tracked, rpm, band))
+    run = gearbox_found(mating_shaft(running_speed(rec, measured, tracked, rpm, band)))
     supply = supply_lines(run)
     severity, gate = iso_severity(measured, run.job, supply)
     rows = shaft_rows(run, supply, gate, line_frequency)
@@ -187,6 +189,8 @@ def _answer(run: Run, rows: list, ev, severity: dict, narrow: list, contradicted
     if "mating_teeth" in speed:
         reason += (f"; the mating gear's {speed['mating_teeth']} teeth measured from the mesh's sidebands (its "
                    "shaft's lines set apart; declare mating_shaft_ratio= to fix it)")
+    if found_note(speed):
+        reason += "; " + found_note(speed)
     if job.converted:
         reason += "; " + _conversion_note(job.converted)
     if "channels_restricted" in job.flags:
