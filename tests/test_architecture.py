@@ -122,3 +122,20 @@ def test_matplotlib_is_imported_only_at_the_edge():
             if any(n.split(".")[0] == "matplotlib" for n in names):
                 found.append(str(p.relative_to(ROOT)))
     assert found == []
+
+
+def test_every_diagnosis_flag_has_its_sentence_and_advice():
+    """A flag the diagnosis sets (``flags.append("...")`` or ``_held(flags, "...")``) is shown in a report
+    only with its sentence (FLAG_TEXT) and advice (FLAG_ADVICE): fifteen were missing, so a report left
+    out ``speed_doubtful`` and the other doubts while the JSON carried them."""
+    import re
+    from vibmeasure.core.results import FLAG_TEXT
+    from vibmeasure.reporting import FLAG_ADVICE
+    flags = set()
+    for path in (Path(__file__).resolve().parents[1] / "vibmeasure" / "monitor").rglob("*.py"):
+        text = path.read_text()
+        flags |= set(re.findall(r'flags\.append\("([a-z_0-9]+)"\)', text))
+        flags |= set(re.findall(r'_held\([^,]+, "([a-z_0-9]+)"', text))
+    assert len(flags) >= 20
+    assert sorted(f for f in flags if f not in FLAG_TEXT) == []
+    assert sorted(f for f in flags if f not in FLAG_ADVICE) == []

@@ -45,6 +45,23 @@ FLAG_ADVICE = {
                       "a comb in the envelope spectrum",
     "dropouts": "check the acquisition chain (buffer overruns, a link that drops out) and record again",
     "saturated": "lower the sensor gain or choose a larger range: clipped samples carry no information",
+    "speed_corrected": "check the declared speed (a nameplate's is the synchronous one), or give tach=",
+    "speed_unchecked": "give tach= (or --tach), or check that the sensor sees the shaft the speed is declared for",
+    "speed_inconsistent": "check the sampling rate and the speed's unit (rpm for Hz, pulses per revolution)",
+    "speed_contradicted": "give the measured speed (rpm=, tach= or rpm_profile=) and run again",
+    "speed_unconfirmed": "check the speed and fs (rpm for Hz, pulses per revolution, the sampling rate), or give tach=",
+    "speed_doubtful": "check the speed and fs (a factor 2 or 4: rpm for Hz, pulses per revolution, the sampling "
+                      "rate), or give tach=; declare gear= for a gearbox",
+    "speed_disagrees_file": "check which speed is right and give it (rpm=, or tach=)",
+    "half_order_ambiguous": "check the speed and fs; look for looseness (rub, a loose foot) on site",
+    "gear_not_seen": "check the speed, the tooth count and that the sensor sees the gear",
+    "gear_elsewhere": "declare gear= (with mating_shaft_ratio=) for the stage the sensor is on",
+    "band_unconfirmed": "analyse without band=, or give a band around the bearing's resonance",
+    "ball_slip_edge": "confirm with a longer or a later record before acting on the ball call",
+    "channels_restricted": "name every channel on the machine to have a fault another sensor sees looked for",
+    "unit_converted": "nothing to do: the levels are converted; a proximity probe's displacement is judged by "
+                      "ISO 20816 / 7919",
+    "unit_unknown": "give unit= (e.g. 'g', 'm/s^2', 'mm/s') for the ISO level and the shaft-order faults",
 }
 
 

@@ -56,6 +56,31 @@ FLAG_TEXT = {
                 "there is lost; they were filled by AR interpolation for the envelope analysis",
     "saturated": "runs of samples sit at the record's extremes: the sensor or converter saturated, the level "
                  "reads low and the clipping adds harmonics",
+    "speed_corrected": "the 1X line (or a gear mesh over its teeth) stands more than 1 % from the declared speed: "
+                       "the measured speed is used",
+    "speed_unchecked": "no 1X line, mesh or tachometer checked the declared speed: it is used as declared",
+    "speed_inconsistent": "the lines fit the declared speed only at another sampling rate (or a tachometer disagrees "
+                          "with the declared speed): the time base is in doubt, the ISO zone withdrawn",
+    "speed_contradicted": "a shaft comb or the bearing's own lines stand where another speed puts them: no "
+                          "shaft-order or bearing fault was looked for at the declared speed",
+    "speed_unconfirmed": "no 1X line confirms the declared speed, and the record shows lines of another (a shaft "
+                         "comb at a multiple, or a 2X without its 1X): the answer is held",
+    "speed_doubtful": "the record's lines (a gear mesh, a line at half the speed, a rival bearing comb) put the "
+                      "shaft at another speed, often 2 or 4 x off: the answer is held",
+    "speed_disagrees_file": "the declared speed differs from the one the file states and no line settles which is "
+                            "right: the answer is held",
+    "half_order_ambiguous": "lines at 0.5X and 1.5X stand about as high as the 1X: a loose machine's "
+                            "sub-harmonics, or a speed (or sampling rate) off by a factor 2",
+    "gear_not_seen": "no mesh line stands at the declared teeth x the speed used: the gear was not checked",
+    "gear_elsewhere": "a gear pair's mesh stands whose shafts are not the one measured (another stage): its "
+                      "lines were not set apart",
+    "band_unconfirmed": "a fault or candidate only the band given shows, against the record's own bands: the "
+                        "band may miss the bearing's resonance",
+    "ball_slip_edge": "the smeared ball comb fits best at the edge of the slip searched: it would fit better "
+                      "outside the range the model allows; the call is held",
+    "channels_restricted": "only the channels named were searched for bearing faults",
+    "unit_converted": "a channel in velocity or displacement units was differentiated to acceleration",
+    "unit_unknown": "a channel's unit is unknown: no ISO level, and shaft-order faults are not called",
 }
 
 
