@@ -10,7 +10,7 @@ import pytest
 
 import vibmeasure as vm
 from vibmeasure.monitor.bearing import evidence, grid
-from vibmeasure.monitor.diagnosis import bearings
+from vibmeasure.monitor.diagnosis import bearings, gearbox
 
 
 def _gearbox(rpm, z1, z2, error, snr, seed):
@@ -26,26 +26,31 @@ def _diagnose(x, rpm, gear):
 
 
 @pytest.mark.parametrize("case", [(3600, 40, 83, 0.1, 10, 0), (3600, 40, 83, 0.02, 30, 0), (3000, 32, 71, 0.1, 30, 0)])
-def test_the_mesh_line_confirms_a_1x_at_the_line_frequency(case):
+def test_the_mesh_line_confirms_a_1x_at_the_line_frequency(case, monkeypatch):
     """A shaft at 3600 or 3000 rpm turns at the line frequency, whose lines are not taken for a 1X; alone,
     the 1X search took the mating shaft's 2X (3470 rpm for 40/83, 2705 rpm for 32/71: 3.6 and 9.8 % off,
     each with its harmonics) or found none. With the gear declared, the mesh line (teeth x the speed)
     and the 1X agree: the speed is the mesh's over the teeth. Tolerance: the mesh line refined on 6 s
-    (0.17 Hz lines) over 32-40 teeth, 0.05 % of the speed."""
+    (0.17 Hz lines) over 32-40 teeth, 0.05 % of the speed. Without a gear declared, the pair found in the
+    spectrum (``diagnosis.gearbox``) measures it as well; the 1X search alone (that step off) does not."""
     rpm, z1, z2, error, snr, seed = case
     x = _gearbox(rpm, z1, z2, error, snr, seed)
     d = _diagnose(x, rpm, vm.Gear(z1, mating_shaft_ratio=z1 / z2))
     assert d.speed["estimated_rpm"] == pytest.approx(rpm, rel=5e-4)
     assert d.speed["mesh_hz"] == pytest.approx(z1 * rpm / 60, rel=5e-4)
     assert not {"speed_corrected", "speed_unconfirmed", "speed_contradicted"} & set(d.flags)
+    found = _diagnose(x, rpm, None)
+    assert found.speed["estimated_rpm"] == pytest.approx(rpm, rel=5e-4) and found.speed["gearbox"]["on_shaft"]
+    monkeypatch.setattr(gearbox, "find_gearbox", lambda f, A, f1: None)
     alone = _diagnose(x, rpm, None)
     assert alone.speed["estimated_rpm"] is None or abs(alone.speed["estimated_rpm"] / rpm - 1) > 0.03
 
 
-def test_a_wrong_tooth_count_falls_back_to_the_1x_search():
+def test_a_wrong_tooth_count_falls_back_to_the_1x_search(monkeypatch):
     """Declared with 41 teeth where the gear has 40, no 1X stands at the strongest line's 41st
-    sub-harmonic: the mesh confirms nothing, and the speed is read as without a gear (here, as the
-    1X search alone reads it)."""
+    sub-harmonic: the mesh confirms nothing, and the speed is read as without a gear by the 1X search
+    alone (a declared gear, even a wrong one, is not replaced by the pair the spectrum shows)."""
+    monkeypatch.setattr(gearbox, "find_gearbox", lambda f, A, f1: None)
     x = _gearbox(3600, 40, 83, 0.1, 10, 0)
     wrong = _diagnose(x, 3600, 41)
     assert "mesh_hz" not in wrong.speed
@@ -94,6 +99,7 @@ def test_a_bearing_comb_on_the_hunting_tooth_grid_is_not_called(monkeypatch):
     assert d.top != "bearing_inner_race" and inner.p_value < 1e-5
     assert "hunting-tooth comb (a line every 0.597 Hz" in inner.not_called
     monkeypatch.setattr(grid, "HUNT_TOL", 0.0)
+    monkeypatch.setattr(grid, "HUNT_TOL_MAX", 0.0)
     assert _diagnose(x, 2400, gear).top == "bearing_inner_race"
 
 
@@ -143,3 +149,19 @@ def test_a_speed_declared_half_the_mesh_s_is_doubted(case):
         assert "2 x where the declared" in d.reason
     right = _diagnose(x, rpm, z1)
     assert "mesh_factor" not in right.speed and "speed_doubtful" not in right.flags
+
+
+def test_weak_lines_on_the_grid_widen_the_tolerance_while_chance_stays_under_one_per_cent():
+    """Oracle: a comb of n lines falls on a grid of s lines by chance as often as (2 tol / s)^n. Two lines
+    keep HUNT_TOL (0.25: on a 4.3-line grid 1.3 % by chance); four lines on it reach HUNT_TOL_MAX (0.35:
+    0.07 %); three on a 2.5-line grid stop where the chance is 1 % (0.27). A rough 40/83 gearbox at 30
+    dB (20 % tooth errors, no gear declared: the pair found) put a four-line ball comb on its grid, the
+    lines 8-13 dB over their floor and up to 0.30 line off it (the parabola's error on weak lines):
+    called ball at 0.52 before, now not."""
+    assert grid.grid_tolerance(2, 4.34) == pytest.approx(0.25)
+    assert grid.grid_tolerance(4, 4.34) == pytest.approx(0.35)
+    assert grid.grid_tolerance(3, 2.5) == pytest.approx(1.25 * 0.01 ** (1 / 3))
+    assert (2 * grid.grid_tolerance(3, 2.5) / 2.5) ** 3 == pytest.approx(0.01)
+    d = _diagnose(_gearbox(3600, 40, 83, 0.2, 30, 0), 3600, None)
+    assert not (d.top.startswith("bearing") and d.confidence >= 0.5), d.reason
+    assert "hunting-tooth comb" in d.faults.set_index("fault").loc["bearing_ball", "not_called"]

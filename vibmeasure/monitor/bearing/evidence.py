@@ -11,7 +11,7 @@ from ...core.errors import ParameterError
 from .cage import _cage_floor
 from .decoys import _decoy_p, _speed_scan
 from .families import HALVES, _accepted, _claim_artefact, _claim_shaft, _explain, _shaft_shows
-from .grid import HUNT_TOL, on_grid
+from .grid import HUNT_TOL, HUNT_TOL_MAX, on_grid
 from .lines import _log_p_to_conf
 from .rules import ALPHA, FAMILIES, MIN_VOTES, R_LINE, SAME_DATA, SINGLE_VIEW_P, SLIP
 from .smeared import _call_smeared, _smeared_ball
@@ -107,7 +107,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
         where a bearing line could stand, since whichever speed is true they are a shaft's lines.
     hunting_hz : float, optional
         The spacing (Hz) of a gear pair's hunting-tooth comb (f1 x gcd(z1, z2) / z2): a family whose
-        standing lines all lie on it is not found (HUNT_TOL).
+        standing lines all lie on it is not found (``grid.grid_tolerance``).
 
     Returns
     -------
@@ -371,7 +371,7 @@ def _not_called(name: str, fam: dict, n_sp: int, n_views: int) -> str | None:
     if fam.get("hunting_comb"):
         why.append(f"every line of its comb stands on the gears' hunting-tooth comb (a line every "
                    f"{fam['hunting_comb']:.3f} Hz: the two gears' tooth errors repeat together), within "
-                   f"{HUNT_TOL:g} of the spectrum's line spacing: the gearbox's lines, not the bearing's")
+                   f"{HUNT_TOL:g}-{HUNT_TOL_MAX:g} of the spectrum's line spacing: the gearbox's lines, not the bearing's")
     if fam.get("against_own"):
         why.append(f"only the band given shows it, while the record's own bands show {', '.join(fam['against_own'])}")
     if not why and not fam["votes"]:
