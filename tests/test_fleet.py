@@ -502,6 +502,22 @@ def test_cli_batch_fails_when_every_input_failed_and_ctrl_c_is_one_line(tmp_path
     assert vm.Store(tmp_path / "big.db").n_measurements == n   # what it said it stored is there
 
 
+def test_cli_batch_first_ctrl_c_waits_for_the_input_in_hand_and_a_second_does_not():
+    """The first SIGINT only marks the batch to stop between inputs (an interrupt raised inside compiled
+    code could end the interpreter by SIGINT instead of exit 130); a second one interrupts at once; the
+    handler that was there before is back afterwards."""
+    from vibmeasure.cli.batch import _stop_between_inputs
+    before = signal.getsignal(signal.SIGINT)
+    with _stop_between_inputs() as asked:
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.05)   # the handler runs at the next bytecode boundary
+        assert asked == [signal.SIGINT]
+        with pytest.raises(KeyboardInterrupt):
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)
+    assert signal.getsignal(signal.SIGINT) is before
+
+
 def _one_row_store(path):
     with vm.Store(path, writable=True) as st:
         st.add_asset("pump-1")
