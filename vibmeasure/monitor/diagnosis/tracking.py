@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...core.errors import ParameterError
+from ...signal.spectral import fast_len_below
 from .lines import LINE_DB, _refine
 
 if TYPE_CHECKING:   # for annotations only
@@ -146,7 +147,7 @@ def _order_tracked_job(job: Job, tracked: dict, band):
     from ...signal.demod import angle_grid, at_times
     spr = job.fs / (tracked["min_rpm"] / 60.0)          # the slowest speed's whole band is kept
     _, t_grid = angle_grid(tracked["angle"], job.fs, spr)
-    t_grid = t_grid[:_fast_len_below(t_grid.size)]   # a length with small prime factors: the FFTs stay fast
+    t_grid = t_grid[:fast_len_below(t_grid.size)]   # a length with small prime factors: the FFTs stay fast
     signals = {k: at_times(x, job.fs, t_grid) for k, x in job.signals.items()}
     note = (f"speed {tracked['min_rpm']:.0f}-{tracked['max_rpm']:.0f} rpm (from the {tracked['source']}): shaft "
             f"orders and bearing lines analysed after angular resampling; frequencies are orders x the mean "
@@ -154,13 +155,3 @@ def _order_tracked_job(job: Job, tracked: dict, band):
     out = replace(job, fs=spr * f_mean, rpm=tracked["mean_rpm"], signals=signals, a=signals[job.primary],
                   flags=job.flags + ["order_tracked"])
     return out, note
-
-
-def _fast_len_below(n: int) -> int:
-    """The largest length <= n whose prime factors are 2, 3 and 5 (at most 4 % shorter from 10^4 samples
-    on, 2.8 % from 10^5: measured over every length)."""
-    from scipy.fft import next_fast_len
-    m = n
-    while m > 1 and next_fast_len(m, real=True) != m:
-        m -= 1
-    return m
