@@ -135,3 +135,20 @@ def test_a_gear_whose_mesh_is_not_seen_is_said():
     assert "gear_not_seen" in d.flags and "the gear was not checked" in d.reason
     assert d.top == "none" and d.confidence >= 0.5
     assert "gear_not_seen" not in _diagnose(rec, rpm).flags
+
+
+@pytest.mark.parametrize("fault", ["bearing_outer_race", "bearing_ball"])
+def test_a_bearing_comb_at_four_times_an_unconfirmed_speed_contradicts_it(fault):
+    """A bearing fault under a gearbox's mesh at 3000 rpm (its 1X on the supply's 50 Hz, so no 1X
+    confirms the speed), read with fs declared 4 x the true rate: every line stands 4 x higher, and the
+    bearing's comb with them. At the true rate it is named; at 4 x fs the speed is contradicted near
+    12,000 rpm (within the scan's 6 % window) and the advice names fs, instead of "none" or a fault
+    unflagged. Oracle: synth.machine's fault and the factor the mistake makes."""
+    rec = vm.synth.machine(rpm=3000, gear_teeth=32, mating_teeth=71, fs=12000.0, duration=6.0, fault=fault,
+                           mesh=0.5, tooth_error=0.05, seed=0)
+    x = rec.data[0]
+    assert _diagnose(vm.Record.from_array(x, fs=12000.0, names=["acc"], unit="g"), 3000).top == fault
+    d = _diagnose(vm.Record.from_array(x, fs=48000.0, names=["acc"], unit="g"), 3000)
+    assert "speed_contradicted" in d.flags and d.top not in (fault, "none"), d.reason
+    assert d.speed["contradicting_rpm"] == pytest.approx(12000.0, rel=0.06)
+    assert "check fs: a sampling rate declared 4 x too high" in d.reason

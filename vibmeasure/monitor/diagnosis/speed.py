@@ -354,8 +354,19 @@ def _bearing_contradiction(job: Job, speed: dict, f1: float, other: dict):
                                for u in other.get("other_factors", ())[:2])
                      + " (or the bearing declared is not the one that shows). Shaft-order and bearing faults "
                      "are not looked for at a speed the record contradicts: give the measured speed (rpm=, or "
-                     "tach= / rpm_profile=)"))
+                     "tach= / rpm_profile=)" + _whole_factor(rpm / job.rpm)))
     job.flags.append("speed_contradicted")
+
+
+def _whole_factor(u: float) -> str:
+    """Advice where the contradicting speed is a whole factor (2, 4 or their inverses) of the declared
+    one: every frequency off by that factor is as likely a sampling rate off by it."""
+    for k in (2, 4):
+        for v, word in ((k, "high"), (1 / k, "low")):
+            if abs(u / v - 1) <= 0.06:   # decoys.FACTOR_WINDOW
+                return f", or check fs: a sampling rate declared {k} x too {word} reads every line {k} x too {word}"
+    return ""
+
 
 
 @dataclass(frozen=True)
