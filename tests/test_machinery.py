@@ -1264,21 +1264,3 @@ def test_fast_len_below_gives_the_largest_smooth_length():
             assert fast_len_below(n, real=real) == want
     assert fast_len_below(120801, real=False) == 120736   # CWRU's 3 x 67 x 601 samples: 0.05 % cut
 
-
-def test_a_record_of_awkward_length_is_cut_to_a_fast_one_with_its_profile():
-    # 48,007 samples = 61 x 787: diagnose cuts to 48,000 (0.015 %), the rpm profile with it; the answer
-    # is that of the record cut by hand (the same samples), and a profile of another length is refused
-    # by the speed step as before, not cut
-    from vibmeasure.monitor.diagnosis.job import fast_length
-    rec = vm.synth.machine(fault="bearing_inner_race", rpm=1797, duration=4.0, fs=12001.75, seed=1)
-    assert rec.n_samples == 48007
-    cut, tach, prof = fast_length(rec, None, np.full(rec.n_samples, 1797.0))
-    assert cut.n_samples == 48000 and tach is None and prof.size == 48000
-    assert np.array_equal(cut.data, rec.data[:, :48000])
-    assert fast_length(rec, None, np.full(10, 1797.0))[0] is rec
-    d = vm.diagnose(rec, rpm=1797, bearing="6205-2RS")
-    by_hand = vm.diagnose(vm.Record.from_array(rec.data[:, :48000], fs=rec.fs, names=list(rec.names), unit="g"),
-                          rpm=1797, bearing="6205-2RS")
-    assert d.top == by_hand.top == "bearing_inner_race" and d.confidence == by_hand.confidence
-    p = vm.diagnose(rec, rpm_profile=np.full(rec.n_samples, 1797.0), bearing="6205-2RS")
-    assert p.top == "bearing_inner_race"

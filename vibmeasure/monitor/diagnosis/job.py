@@ -48,31 +48,6 @@ class Job:
 
 # --- prepare ---------------------------------------------------------------------------------------
 
-# Every spectrum of the diagnosis is an FFT of the record's length, and a length with a large prime
-# factor makes each several times slower (CWRU's 120,801 samples = 3 x 67 x 601: 22 ms per rfft against
-# 4 ms at 120,736): the record is cut to the longest fast length below it (prime factors 2 to 11) where
-# that drops at most FAST_CUT of it. The development records lose 0.02-0.33 % of their end, their 45
-# answers unchanged, and diagnose takes a fifth less time.
-FAST_CUT = 0.01
-
-
-def fast_length(rec, tach, rpm_profile) -> tuple:
-    """(record, tach, rpm_profile) cut to a fast FFT length (``FAST_CUT``); a tachometer or profile
-    given as samples is cut with it. Left whole where the cut would be longer, or where a profile's
-    length is not the record's (the speed step then says so)."""
-    from ...signal.spectral import fast_len_below
-    n = rec.n_samples
-    m = fast_len_below(n, real=False)
-    samples = [a for a in (tach, rpm_profile) if a is not None and not isinstance(a, (str, int, np.integer))]
-    if m == n or n - m > FAST_CUT * n or any(np.ndim(a) != 1 or len(a) != n for a in samples):
-        return rec, tach, rpm_profile
-
-    def cut(a):
-        return a if a is None or isinstance(a, (str, int, np.integer)) else np.asarray(a)[:m]
-    return rec.replace(data=rec.data[:, :m], note=f"first {m} of {n} samples (a fast FFT length)"), cut(tach), \
-        cut(rpm_profile)
-
-
 def _accel(rec, i, flags, quality, block):
     """Channel i as float64, in m/s^2 when its unit is known (``_in_acceleration``), with its isolated
     spikes repaired (``signal.quality``); ``quality`` (channel -> findings) collects what the samples

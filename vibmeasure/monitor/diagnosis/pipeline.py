@@ -22,7 +22,7 @@ from ...core.results import Diagnosis
 from .bearings import _narrow_channels, _plot_material, bearing_step, other_speed_rows
 from . import doubts
 from .decide import _decide, _unweighed, candidates
-from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note, fast_length
+from .job import DIFFERENTIATIONS, Job, _prepare, _quality_note
 from .mains import supply_lines
 from .gearbox import found_note, gearbox_found
 from .mating import mating_shaft
@@ -110,7 +110,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     >>> d.top, d.confidence > 0.9
     ('bearing_inner_race', True)
     """
-    rec, tach, rpm_profile = fast_length(as_record(rec, fs=fs), tach, rpm_profile)
+    rec = as_record(rec, fs=fs)
     tracked = _tracked_speed(rec, tach, rpm_profile, pulses_per_rev)
     rpm = tracked["mean_rpm"] if rpm is None and tracked is not None else rpm
     measured = _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channels, band, prewhitening,
