@@ -77,7 +77,10 @@ FACTOR_WINDOWS = tuple((u * (1 - FACTOR_WINDOW), u * (1 + FACTOR_WINDOW)) for u 
 # Where no 1X confirms the speed, 4 x it is searched too (fs declared 4 x the true rate, 48 kHz for
 # 12): a bearing fault under a mesh at 3000 rpm, whose 1X is the supply's line, read at 4 x fs was
 # answered "none" at 0.57 or "undetermined", unflagged. Every development record with its 1X taken as
-# not found (the scan forced): no contradiction added (B007_1's, above, stays the only one).
+# not found (the scan forced): no contradiction added (B007_1's, above, stays the only one). Not where
+# the speed step already doubts the speed by a shaft comb or the time base: the test runs at the speed
+# that doubt names, and a contradiction would drop it (CWRU fan-end records read at 4 x fs lost 5
+# faults named that way).
 UNCONFIRMED_WINDOWS = ((4.0 * (1 - FACTOR_WINDOW), 4.0 * (1 + FACTOR_WINDOW)),)
 
 
@@ -134,7 +137,7 @@ def _declared(hz: list, freqs: dict, df: float) -> bool:
 
 
 def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, confirmed: bool = False,
-                hunting_hz: float | None = None) -> tuple:
+                hunting_hz: float | None = None, four: bool = True) -> tuple:
     """(contradiction, rival). The contradiction: the bearing comb that contradicts the declared speed
     (see SPEED_SCAN; where a 1X ``confirmed`` the speed, only within FACTOR_WINDOWS), or None. The
     rival: the best significant comb within FACTOR_WINDOWS when it does not contradict the speed yet is
@@ -148,7 +151,9 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
     bearing's."""
     n_sp = max(1, len(spectra))
     found, declared = [], 0.0
-    ranges = FACTOR_WINDOWS if confirmed else (SPEED_SCAN,) + FACTOR_WINDOWS + UNCONFIRMED_WINDOWS
+    # ``four``: 4 x the speed is searched too where nothing confirmed it (UNCONFIRMED_WINDOWS), unless the
+    # time base is in doubt already (the speed step named its factor and the test runs at that speed too)
+    ranges = FACTOR_WINDOWS if confirmed else (SPEED_SCAN,) + FACTOR_WINDOWS + (UNCONFIRMED_WINDOWS if four else ())
     for ses in spectra:
         saved, ses.r = ses.r, ses.r_base if ses.r_base is not None else ses.r
         try:

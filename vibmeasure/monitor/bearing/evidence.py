@@ -64,7 +64,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
                      shaft_hz: float | None = None, f1_known: bool = True, whitening=("cepstral",),
                      artefact_hz=(), speed_search: float | None = None, speed_confirmed: bool | None = None,
                      smeared_ball: bool = True, other_shafts_hz=(), shaft_combs_hz=(),
-                     hunting_hz: float | None = None) -> BearingEvidence:
+                     hunting_hz: float | None = None, time_base_doubted: bool = False) -> BearingEvidence:
     """Evidence per bearing family over every channel of a record, as a statistical test.
 
     Parameters
@@ -108,6 +108,10 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     hunting_hz : float, optional
         The spacing (Hz) of a gear pair's hunting-tooth comb (f1 x gcd(z1, z2) / z2): a family whose
         standing lines all lie on it is not found (``grid.grid_tolerance``).
+    time_base_doubted : bool
+        The speed step found the lines fit only at another fs (``shaft_hz`` then differs from f1), or a
+        shaft comb standing at another speed (``shaft_combs_hz``): the scan of other speeds leaves out
+        4 x f1 (``decoys.UNCONFIRMED_WINDOWS``); that doubt names the speed and the test runs there too.
 
     Returns
     -------
@@ -139,7 +143,7 @@ def bearing_evidence(signals: dict, fs: float, f1: float, freqs: dict, n_balls: 
     _confidences(fams, votes, smeared, len(spectra), _views(spectra))
     confirmed = f1_known if speed_confirmed is None else speed_confirmed
     other, rival = (None, None) if speed_search is None else _speed_scan(spectra, freqs, f1, speed_search, confirmed,
-                                                                           hunting_hz)
+                                                                           hunting_hz, not time_base_doubted)
     kurtogram = next((s.kurtogram for s in spectra if s.kurtogram is not None), None)
     return BearingEvidence(fams, spectra, kurtogram, len(spectra), measured, other, rival)
 

@@ -83,7 +83,7 @@ def _evidence(job: Job, f1: float, shaft: float, f1_known: bool, speed_search, s
                             artefact_hz=glitch, speed_search=speed_search, speed_confirmed=speed_confirmed,
                             smeared_ball=not ("speed_varies" in job.flags and "order_tracked" not in job.flags),
                             other_shafts_hz=_other_shafts(job, shaft), shaft_combs_hz=elsewhere,
-                            hunting_hz=_hunting(job, shaft))
+                            hunting_hz=_hunting(job, shaft), time_base_doubted=shaft != f1 or bool(elsewhere))
 
 
 def other_speed_rows(run: Run, rows: list, ev) -> list:
