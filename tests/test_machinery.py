@@ -1263,4 +1263,7 @@ def test_fast_len_below_gives_the_largest_smooth_length():
             want = max(m for m in range(1, n + 1) if smooth(m, primes))
             assert fast_len_below(n, real=real) == want
     assert fast_len_below(120801, real=False) == 120736   # CWRU's 3 x 67 x 601 samples: 0.05 % cut
+    for bad in (0, -5, 2.5, True):
+        with pytest.raises(vm.ParameterError, match="n=.*whole number >= 1"):
+            fast_len_below(bad)
 

@@ -65,12 +65,19 @@ def fast_len_below(n: int, *, real: bool = True) -> int:
     -------
     int
 
+    Raises
+    ------
+    ParameterError
+        For n not a whole number >= 1.
+
     Examples
     --------
     >>> from vibmeasure.signal.spectral import fast_len_below
     >>> fast_len_below(120801), fast_len_below(120801, real=False)
     (120000, 120736)
     """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ParameterError(f"n={n!r} must be a whole number >= 1")
     m = int(n)
     while m > 1 and _fft.next_fast_len(m, real=real) != m:
         m -= 1
