@@ -1,7 +1,6 @@
 """Damaged, truncated and hostile files; writers killed mid-write; concurrent history updates.
 Each test is named after the rule it checks. benchmarks/fuzz.py runs the same classes at scale."""
 import os
-import signal
 import subprocess
 import sys
 import textwrap
@@ -16,6 +15,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import vibmeasure as vm
+
+from ._forked import Forked
 
 
 @pytest.fixture
@@ -283,10 +284,9 @@ def test_temporary_files_of_a_killed_writer_are_cleaned_on_the_next_write(tmp_pa
     assert not stale.exists()
 
 
-WRITER = textwrap.dedent("""
-    import sys, numpy as np, vibmeasure as vm
-    path, kind = sys.argv[1], sys.argv[2]
-    rec = vm.Record(np.random.default_rng(0).normal(size=(4, 200000)), 1000.0)
+def _writer(path, kind, n, *, out):
+    """Writes one record (or history) file over and over until killed; prints a line after each write."""
+    rec = vm.Record(np.random.default_rng(0).normal(size=(4, n)), 1000.0)
     i = 0
     while True:
         i += 1
@@ -297,29 +297,36 @@ WRITER = textwrap.dedent("""
             h.save(path)
         else:
             vm.write(path, rec.replace(data=rec.data + i))
-""")
+        print(i, file=out)
 
 
 @pytest.mark.parametrize("name", ["r.h5", "r.csv", "r.wav", "history.h5"])
 def test_kill_9_at_any_moment_leaves_the_previous_file_or_the_new_one(tmp_path, name):
-    script = tmp_path / "writer.py"
-    script.write_text(WRITER)
+    # the first writer is killed at a random moment from its start (before or during its first write);
+    # the others after their first complete write, at a random moment within the next one or two
+    # (a CSV holds fewer samples, so that its write takes about as long as the others')
     path = tmp_path / name
     kind = "history" if name.startswith("history") else "record"
+    n = 20_000 if name.endswith(".csv") else 200_000
     rng = np.random.default_rng(1)
     for trial in range(6):
-        proc = subprocess.Popen([sys.executable, str(script), str(path), kind])
-        time.sleep(0.8 + rng.uniform(0, 1.2))
-        proc.send_signal(signal.SIGKILL)
-        proc.wait()
+        t0 = time.monotonic()
+        proc = Forked(_writer, path, kind, n)
+        if trial:
+            assert proc.readline().strip(), "the writer ended before its first write"
+            time.sleep(rng.uniform(0, 1.5) * (time.monotonic() - t0))
+        else:
+            time.sleep(rng.uniform(0.05, 0.5))
+        proc.kill()
         if path.exists():
             if kind == "history":
                 assert len(vm.History.load(path).entries) == 29
             else:
                 r = vm.read(path)
-                assert r.data.shape == (4, 200000)
+                assert r.data.shape == (4, n)
+    assert path.exists()
     leftovers = list(tmp_path.glob(f".{name}.*.part"))
-    if path.exists() and kind == "record":
+    if kind == "record":
         vm.write(path, vm.read(path))    # the next write removes what the killed writers left
         assert not list(tmp_path.glob(f".{name}.*.part"))
     assert all(p.name.endswith(".part") for p in leftovers)

@@ -3,7 +3,6 @@ start themselves), the HDF5 store migrated, and both engines held to the HDF5 st
 
 import json
 import random
-import signal
 import sqlite3
 import subprocess
 import sys
@@ -17,6 +16,8 @@ import pytest
 import vibmeasure as vm
 from vibmeasure.cli import main as cli_main
 from vibmeasure.io.sql import SQLStore
+
+from ._forked import Forked
 
 
 def _fill(st, n=3, raw=True):
@@ -167,25 +168,39 @@ WRITER = textwrap.dedent("""
 """)
 
 
+def _writer(path, *, out):
+    """Measurements with their result and raw data, one commit each, until killed; prints each id."""
+    st = vm.Store(path, writable=True, timeout=30)
+    st.add_asset("a")
+    st.add_point("a", "p")
+    st.commit()
+    for i in range(100000):
+        mid = st.add_measurement("a", "p", time=1.7e9 + i, record=vm.Record.from_array(np.full(2000, float(i)),
+                                 fs=100.0), keep_raw=True)
+        st.add_result(mid, "x", {"n": i}, summary={"n": i})
+        st.commit()
+        print(mid, file=out)
+
+
 def test_kill_9_at_any_moment_loses_no_committed_row(tmp_path):
     """30 writers of one SQLite store killed at random moments: the store always opens, holds every
     measurement a writer reported committed, and each holds its result and its raw record. Every fifth
     writer is killed at a random moment from its start (often before its first commit); the others at a
-    random moment after their first commit, whatever their start-up takes on a loaded machine (a fixed
-    0.8-1.8 s from the start killed every writer before its first commit beside two benchmarks)."""
+    random moment after their first commit."""
+    import sqlalchemy  # noqa: F401  (each fork starts with the engine imported, as a running writer has it)
     rng = random.Random(47)
     p = tmp_path / "s.db"
     reported = set()
     for trial in range(30):
-        proc = subprocess.Popen([sys.executable, "-c", WRITER, str(p)], stdout=subprocess.PIPE, text=True)
+        proc = Forked(_writer, p)
         if trial % 5:
-            reported |= set(proc.stdout.readline().split())   # the first commit, then a random moment
+            first = proc.readline().split()   # the first commit, then a random moment
+            assert first, "the writer ended before its first commit"
+            reported |= set(first)
             time.sleep(rng.uniform(0.0, 0.6))
         else:
-            time.sleep(rng.uniform(0.05, 1.8))
-        proc.send_signal(signal.SIGKILL)
-        out, _ = proc.communicate()
-        reported |= set(out.split())
+            time.sleep(rng.uniform(0.0, 0.5))
+        reported |= set(proc.kill().split())
     st = vm.Store(p)
     m = st.measurements()
     assert reported and reported <= set(m["id"])

@@ -153,13 +153,14 @@ def _heights(A: np.ndarray, df: float, hz: np.ndarray, tol: int, ring: int) -> n
     """Height in dB of the strongest bin within +-tol bins of each frequency over the median of the
     bins within +-ring (the line's own bins left out); -inf outside the spectrum."""
     out = np.full(hz.size, -np.inf)
-    for j, x in enumerate(hz):
-        i = int(round(x / df))
-        if i - ring < 1 or i + ring >= A.size:
-            continue
-        peak = A[i - tol: i + tol + 1].max()
-        floor = np.median(np.concatenate([A[i - ring: i - tol - 1], A[i + tol + 2: i + ring + 1]]))
-        out[j] = 20 * np.log10(peak / max(floor, 1e-300))
+    i = np.rint(np.asarray(hz, float) / df).astype(int)
+    inside = (i - ring >= 1) & (i + ring < A.size)
+    if not inside.any():
+        return out
+    i = i[inside, None]
+    peak = A[i + np.arange(-tol, tol + 1)].max(axis=1)
+    floor = np.median(A[i + np.r_[np.arange(-ring, -tol - 1), np.arange(tol + 2, ring + 1)]], axis=1)
+    out[inside] = 20 * np.log10(peak / np.maximum(floor, 1e-300))
     return out
 
 
