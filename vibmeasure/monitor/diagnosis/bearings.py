@@ -25,15 +25,24 @@ if TYPE_CHECKING:   # for annotations only
 
 # --- bearings ---------------------------------------------------------------------------------------
 
-def _bearing_rows(job: Job, f1: float, speed: dict, elsewhere: tuple = ()):
-    """One row per bearing family from the statistical test over every channel; the evidence. The
-    shaft combs standing ``elsewhere`` (Hz: ``doubts.shaft_elsewhere``) claim every harmonic of theirs:
-    whichever speed is true, they are a shaft's lines (CWRU fan-end OR007@12_0 with its sampling rate
-    declared twice too high took the true shaft's 2X, 3X, 5X, 7X for BPFI +-1X)."""
+def record_evidence(job: Job, run: Run, speed_search: float | None = SPEED_SEARCH):
+    """The bearing test over ``job``'s channels at the run's speed (``_evidence``); ``speed_search`` None
+    leaves out the scan of other speeds. The shaft combs standing elsewhere (``doubts.shaft_elsewhere``)
+    claim every harmonic of theirs: whichever speed is true, they are a shaft's lines (CWRU fan-end
+    OR007@12_0 with its sampling rate declared twice too high took the true shaft's 2X, 3X, 5X, 7X for
+    BPFI +-1X)."""
+    speed, f1 = run.speed, run.f1
+    elsewhere = tuple(k * run.job.rpm / 60.0 for k in shaft_elsewhere(run))
+    return _evidence(job, f1, f1 / speed.get("fs_ratio", 1), speed["estimated_rpm"] is not None, speed_search,
+                     _confirmed(speed), elsewhere)
+
+
+def _bearing_rows(run: Run):
+    """One row per bearing family from the statistical test over every channel; the evidence."""
+    job = run.job
     if job.bearing is None:
         return [], None
-    ev = _evidence(job, f1, f1 / speed.get("fs_ratio", 1), speed["estimated_rpm"] is not None, SPEED_SEARCH,
-                   _confirmed(speed), elsewhere)
+    ev = record_evidence(job, run)
     rows = []
     for name, s in ev.families.items():
         lines = [f"{ln['hz']:.1f} Hz {ln['db']:.0f} dB" for ln in s["lines"] if ln["r"] >= 6.0]
@@ -278,8 +287,7 @@ def bearing_step(run: Run) -> tuple[list, object, bool]:
     """(rows, evidence, contradicted): the bearing rows unless the speed is contradicted; the bearing's
     own lines standing where another speed puts them contradict it too (``decoys._speed_scan``)."""
     contradicted = "speed_contradicted" in run.job.flags
-    elsewhere = tuple(k * run.job.rpm / 60.0 for k in shaft_elsewhere(run)) if not contradicted else ()
-    rows, ev = _bearing_rows(run.job, run.f1, run.speed, elsewhere) if not contradicted else ([], None)
+    rows, ev = _bearing_rows(run) if not contradicted else ([], None)
     if ev is not None and ev.speed_scan is not None:
         _bearing_contradiction(run.job, run.speed, run.f1, ev.speed_scan)
         contradicted = True

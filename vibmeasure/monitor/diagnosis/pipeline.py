@@ -5,7 +5,8 @@ the 1X, its consistency with fs, order tracking) -> the gear pair's shafts (``ma
 mate; ``gearbox``: a pair the spectrum shows where none is declared) -> the supply's lines (``mains``) -> ISO 10816-3
 severity (``severity``) -> shaft-order faults (``shaft``: gated by severity) -> bearing families
 (``bearings``: the statistical test of monitor/bearing on every channel, never gated by severity;
-again at the file's own speed where it disputes the declared one)
+again at the file's own speed where it disputes the declared one) -> the bearing call tested again on
+the record cut 1-2 % short (``stability``)
 -> the gear (``gears``) -> decision (``decide``: the top, its calibrated confidence and its reason)
 -> the doubts the answer carries (``doubts``: time base, speed, factor 2, the user's band).
 """
@@ -30,6 +31,7 @@ from .severity import iso_severity
 from .gears import gear_rows
 from .shaft import gate_rows, shaft_rows
 from .speed import Run, running_speed
+from .stability import survives_a_cut
 from .tracking import _measured_speed
 
 __all__ = ["diagnose"]
@@ -121,6 +123,7 @@ def diagnose(rec, *, rpm: float | None = None, bearing=None, gear=None, machine_
     rows = shaft_rows(run, supply, gate, line_frequency)
     b_rows, ev, contradicted = bearing_step(run)
     b_rows = other_speed_rows(run, b_rows, ev)
+    b_rows = survives_a_cut(run, b_rows, ev)
     narrow = _narrow_channels(ev, run.job, run.f1) if ev is not None and run.job.band is None else []
     rows += b_rows + gear_rows(run)
     gate_rows(rows, run.job.flags, contradicted)
