@@ -58,6 +58,8 @@ FLAG_ADVICE = {
     "gear_elsewhere": "declare gear= (with mating_shaft_ratio=) for the stage the sensor is on",
     "band_unconfirmed": "analyse without band=, or give a band around the bearing's resonance",
     "ball_slip_edge": "confirm with a longer or a later record before acting on the ball call",
+    "bearing_call_unstable": "measure again, longer (a minute or more) or under another load, before acting on "
+                             "the candidate",
     "channels_restricted": "name every channel on the machine to have a fault another sensor sees looked for",
     "unit_converted": "nothing to do: the levels are converted; a proximity probe's displacement is judged by "
                       "ISO 20816 / 7919",

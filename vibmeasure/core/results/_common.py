@@ -78,6 +78,8 @@ FLAG_TEXT = {
                         "band may miss the bearing's resonance",
     "ball_slip_edge": "the smeared ball comb fits best at the edge of the slip searched: it would fit better "
                       "outside the range the model allows; the call is held",
+    "bearing_call_unstable": "the bearing family called is not called on the record cut 1-2 % short: its comb rests "
+                             "on where the record ends, not on the bearing; no bearing fault is named",
     "channels_restricted": "only the channels named were searched for bearing faults",
     "unit_converted": "a channel in velocity or displacement units was differentiated to acceleration",
     "unit_unknown": "a channel's unit is unknown: no ISO level, and shaft-order faults are not called",

@@ -42,6 +42,7 @@ class Job:
     converted: dict = field(default_factory=dict)  # channel -> the velocity or displacement unit it was read in
     file_rpm: float | None = None   # the speed the file states, when a declared rpm overrides it
     at_other_speeds: list = field(default_factory=list)  # {rpm, why, where, found: {family: p}} per speed tried
+    cut_retest: dict = field(default_factory=dict)   # the bearing call's test on the record cut short (``stability``)
     unit_share: float | None = None  # a velocity/displacement label's high-band share (``_unit_plausibility``)
     found_gear: tuple | None = None  # (Gear, its shaft's Hz): a pair the spectrum shows, none declared (``gearbox``)
 

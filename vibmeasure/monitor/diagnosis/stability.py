@@ -1,20 +1,25 @@
 """Step: a bearing call must survive its record cut short. A fault's comb is the machine's: it stands
-wherever the record happens to end. A comb that a cut of 1-2 % of the samples makes or unmakes rests on
-how its lines fall between the spectrum's bins, not on the bearing. So the family called is tested
-again on the record's first CUT_SHARE (to a fast FFT length, 1-2 % shorter); where that test calls
-another family or none, no bearing fault is named (``bearing_call_unstable``) and the family counts
-against "none" by its p, as an "undetermined" answer's candidate.
+wherever the record happens to end. A call that a cut of 1-2 % of the samples unmakes rests, at least
+in part, on how the comb's lines fall between the spectrum's bins. So the family called is tested again
+on the record's first CUT_SHARE, shortened to a fast FFT length (1-2 % shorter in all):
 
-Measured on the real development records (benchmarks/diagnosis_real.py; docs/validation.md): no right
-call lost; with the other end's bearing declared, two of four false calls withdrawn (CWRU fan-end
-OR007@12_0 outer race at 1.00, OR021@6_0 ball at 0.69); fan-end B021_3 (ball) cut by 1 % read outer
-race at 1.00 and is now withdrawn."""
+- the same family called there: the call stands;
+- another family called there: the record reads two faults, and no bearing fault is named (the
+  families count against "none" by their p, as an "undetermined" answer's candidates);
+- none called, and the family's comb no longer significant there (p above ALPHA): no bearing fault
+  is named either;
+- none called, yet the comb still significant (its call failed on the views, votes or decoys the
+  confidence weighs): the call is named but held under 0.5 (``doubts.unstable_call``).
+
+Every case but the first sets the flag ``bearing_call_unstable``. Measured on the real development
+records at full length and cut by 1 and 2 % (docs/validation.md)."""
 
 from __future__ import annotations
 
 from dataclasses import replace
 
 from ..bearing import FAMILIES
+from ..bearing.rules import ALPHA
 from ...core.errors import ParameterError
 from ...signal.spectral import fast_len_below
 from .bearings import record_evidence
@@ -25,8 +30,10 @@ CUT_SHARE = 0.99   # the re-test's record: its first 99 %, shortened to a fast F
 
 
 def survives_a_cut(run: Run, rows: list, ev) -> list:
-    """The bearing rows, with the family called withdrawn (confidence 0, ``not_called`` says why) where
-    the test on the record's first CUT_SHARE (a fast FFT length below it) does not call it too.
+    """The bearing rows after the call's re-test on the record's first CUT_SHARE (a fast FFT length below
+    it): unchanged where it calls the same family; the called family withdrawn (confidence 0,
+    ``not_called`` says why) where it calls another or finds no significant comb; else unchanged, the
+    re-test kept in ``job.cut_retest`` for the doubt that holds the answer.
 
     Examples
     --------
@@ -43,18 +50,24 @@ def survives_a_cut(run: Run, rows: list, ev) -> list:
     job = run.job
     n = len(next(iter(job.signals.values())))
     n_cut = fast_len_below(int(CUT_SHARE * n), real=False)
-    short = replace(job, signals={k: v[:n_cut] for k, v in job.signals.items()}, flags=list(job.flags))
+    short = replace(job, signals={k: v[:n_cut] for k, v in job.signals.items()}, flags=list(job.flags),
+                    at_other_speeds=[], cut_retest={})
     try:
         other = record_evidence(short, run, speed_search=None)
     except ParameterError:   # too short to test again: the call stands as the record gives it
         return rows
-    there = {name: s["confidence"] for name, s in other.families.items()
-             if name in FAMILIES and s["confidence"] >= TOP_CONFIDENCE}
+    fams = other.families
+    there = {name: fams[name]["confidence"] for name in FAMILIES if fams[name]["confidence"] >= TOP_CONFIDENCE}
     there_top = max(there, key=there.get) if there else None
     if there_top == here:
         return rows
-    read = f"calls {there_top} at {there[there_top]:.2f}" if there_top else "calls no family"
-    run.job.flags.append("bearing_call_unstable")
+    p_there = float(fams[here]["p_value"])
+    job.flags.append("bearing_call_unstable")
+    job.cut_retest.update(family=here, samples=n, cut_to=n_cut, reads=there_top, p_value=p_there)
+    if there_top is None and p_there <= ALPHA:
+        return rows   # held by ``doubts.unstable_call``
+    read = (f"calls {there_top} at {there[there_top]:.2f}" if there_top else
+            f"calls no family (its comb p = {p_there:.2g})")
     for r in rows:
         if r["fault"] in called:
             r["not_called"] = "; ".join(filter(None, [
