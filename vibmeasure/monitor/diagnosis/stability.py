@@ -11,7 +11,9 @@ on the record's first CUT_SHARE, shortened to a fast FFT length (1-2 % shorter i
 - none called, yet the comb still significant (its call failed on the views, votes or decoys the
   confidence weighs): the call is named but held under 0.5 (``doubts.unstable_call``).
 
-Every case but the first sets the flag ``bearing_call_unstable``. Measured on the real development
+Every case but the first sets the flag ``bearing_call_unstable``. A ball called from its smeared comb is
+tested too: with the other end's bearing declared, CWRU fan-end OR007@12_2 cut by 2 % read ball at 0.95
+from humps its shorter record does not show. Measured on the real development
 records at full length and cut by 1 and 2 % (docs/validation.md)."""
 
 from __future__ import annotations
