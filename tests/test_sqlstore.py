@@ -8,6 +8,7 @@ import subprocess
 import sys
 import textwrap
 import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -151,35 +152,28 @@ def test_a_database_that_is_not_a_store_is_named(tmp_path):
         vm.Store(tmp_path / "s.h5", writable=True, raw_dir=tmp_path)
 
 
-WRITER = textwrap.dedent("""
+def _writer(path, raw_dir=None, count=100000, *, out):
+    """``count`` measurements with their result and raw data, one commit each (or until killed); prints
+    each id as it is committed."""
+    st = vm.Store(path, writable=True, timeout=30, raw_dir=raw_dir)
+    st.add_asset("a")
+    st.add_point("a", "p")
+    st.commit()
+    for i in range(count):
+        mid = st.add_measurement("a", "p", time=1.7e9 + i, record=vm.Record.from_array(np.full(2000, float(i)),
+                                 fs=100.0), keep_raw=True)
+        st.add_result(mid, "x", {"n": i}, summary={"n": i})
+        st.commit()
+        print(mid, file=out, flush=True)
+
+
+# the same writer in a process of its own (python -c WRITER store raw_dir count), for writers at once
+WRITER = textwrap.dedent(f"""
     import sys
-    import numpy as np
-    import vibmeasure as vm
-    st = vm.Store(sys.argv[1], writable=True, timeout=30, raw_dir=sys.argv[2] if len(sys.argv) > 2 else None)
-    st.add_asset("a")
-    st.add_point("a", "p")
-    st.commit()
-    for i in range(100000):
-        mid = st.add_measurement("a", "p", time=1.7e9 + i, record=vm.Record.from_array(np.full(2000, float(i)),
-                                 fs=100.0), keep_raw=True)
-        st.add_result(mid, "x", {"n": i}, summary={"n": i})
-        st.commit()
-        print(mid, flush=True)
+    sys.path.insert(0, {str(Path(__file__).resolve().parents[1])!r})
+    from tests.test_sqlstore import _writer
+    _writer(sys.argv[1], sys.argv[2] or None, int(sys.argv[3]), out=sys.stdout)
 """)
-
-
-def _writer(path, *, out):
-    """Measurements with their result and raw data, one commit each, until killed; prints each id."""
-    st = vm.Store(path, writable=True, timeout=30)
-    st.add_asset("a")
-    st.add_point("a", "p")
-    st.commit()
-    for i in range(100000):
-        mid = st.add_measurement("a", "p", time=1.7e9 + i, record=vm.Record.from_array(np.full(2000, float(i)),
-                                 fs=100.0), keep_raw=True)
-        st.add_result(mid, "x", {"n": i}, summary={"n": i})
-        st.commit()
-        print(mid, file=out)
 
 
 def test_kill_9_at_any_moment_loses_no_committed_row(tmp_path):
@@ -216,8 +210,7 @@ def test_concurrent_writers_each_keep_every_row(target, tmp_path):
     ids, every result beside its measurement. SQLite serialises them (each waits for the others'
     transactions); PostgreSQL runs them side by side."""
     url, raw_dir = target
-    script = WRITER.replace("range(100000)", "range(50)")
-    args = [sys.executable, "-c", script, url] + ([str(raw_dir)] if raw_dir else [])
+    args = [sys.executable, "-c", WRITER, url, str(raw_dir or ""), "50"]
     procs = [subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(4)]
     outs = [p.communicate(timeout=300) for p in procs]
     assert all(p.returncode == 0 for p in procs), [e[-500:] for _, e in outs]
@@ -464,8 +457,7 @@ def test_writers_that_open_a_version_1_store_at_once_upgrade_it_once(target, tmp
         for i in range(200):
             st.add_result(st.add_measurement("a", "p", time=1.6e9 + i), "x", {"n": -i}, summary={"n": -i})
     _as_version_1(url)
-    script = WRITER.replace("range(100000)", "range(10)")
-    args = [sys.executable, "-c", script, url] + ([str(raw_dir)] if raw_dir else [])
+    args = [sys.executable, "-c", WRITER, url, str(raw_dir or ""), "10"]
     procs = [subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(4)]
     outs = [p.communicate(timeout=300) for p in procs]
     assert all(p.returncode == 0 for p in procs), [e[-500:] for _, e in outs]
