@@ -13,8 +13,8 @@ on the record's first CUT_SHARE, shortened to a fast FFT length (1-2 % shorter i
 
 Every case but the first sets the flag ``bearing_call_unstable``. A ball called from its smeared comb is
 tested too: with the other end's bearing declared, CWRU fan-end OR007@12_2 cut by 2 % read ball at 0.95
-from humps its shorter record does not show. Measured on the real development
-records at full length and cut by 1 and 2 % (docs/validation.md)."""
+from humps its shorter record does not show. Measured on the real development records at full length
+and cut by 1 and 2 % (benchmarks/diagnosis_cut.py, docs/validation.md)."""
 
 from __future__ import annotations
 
