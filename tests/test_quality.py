@@ -544,7 +544,7 @@ def test_a_knock_under_the_level_is_gated_out_from_the_whitened_signal(shared_da
     cage_window = 2 * 60 / (vm.BEARINGS["6203-2RS"].frequencies(1.0)["FTF"] * rec.meta["rpm"])
     assert all(0.2 <= v["transient_seconds"] <= 0.2 + 4 * cage_window for v in d.extras["data_quality"].values())
     plain = q.transients
-    monkeypatch.setattr(q, "transients", lambda x, block, whiten=False: [] if whiten else plain(x, block))
+    monkeypatch.setattr(q, "transients", lambda x, block, whiten=False, whitened_x=None: [] if whiten else plain(x, block))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", vm.QualityWarning)
         assert vm.diagnose(knocked, rpm=rec.meta["rpm"], bearing="6203-2RS").top == "none"

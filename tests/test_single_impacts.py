@@ -105,5 +105,5 @@ def test_a_knock_on_a_real_faulty_machine_is_gated_and_the_fault_named(shared_da
         d = vm.diagnose(knocked, rpm=rpm, bearing=bearing, channel=channel)
         assert d.top == truth and d.confidence >= 0.9, d.reason
         assert "transients_gated" in d.flags and "a single impact" in d.reason
-        monkeypatch.setattr(q, "isolated_events", lambda x, block: [])
+        monkeypatch.setattr(q, "isolated_events", lambda x, block, whitened_x=None: [])
         assert vm.diagnose(knocked, rpm=rpm, bearing=bearing, channel=channel).top != truth

@@ -1,4 +1,4 @@
-"""One BLAS thread for the small-matrix hot loops.
+"""One BLAS thread for the small-matrix hot loops; a record's channels in threads.
 
 Iterative fits multiply and factor matrices of a few dozen columns thousands of times. OpenBLAS
 splits each of those across all cores; when another process keeps a core busy, every call waits
@@ -12,7 +12,7 @@ from __future__ import annotations
 import contextlib
 import functools
 
-__all__ = ["one_blas_thread", "single_threaded"]
+__all__ = ["one_blas_thread", "single_threaded", "each_in_threads"]
 
 _controller = None
 
@@ -45,3 +45,19 @@ def single_threaded(func):
         with one_blas_thread():
             return func(*args, **kwargs)
     return wrapper
+
+
+def each_in_threads(func, items) -> list:
+    """``[func(item) for item in items]``, the items in threads where there are two or more and two or
+    more cores: a record's channels are analysed alike and apart, and their FFTs and array arithmetic
+    release the GIL (three 12 kHz channels' bearing spectra: 0.90 -> 0.74 s a diagnosis on two cores).
+    The results, and the first exception raised, come in the items' order, as the loop gives them. A
+    pool per call: a fork copies no idle worker it would wait for."""
+    import os
+    items = list(items)
+    workers = min(len(items), os.cpu_count() or 1)
+    if workers < 2:
+        return [func(item) for item in items]
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="vibmeasure-channel") as pool:
+        return list(pool.map(func, items))

@@ -17,21 +17,17 @@ on each side (other comparable far-out samples there excepted, unless there are 
 Two adjacent ones whose flanks are both that much lower are a two-sample glitch. Once any is found,
 an AR model of the record looks again (``_ar_spikes``) for the ones a fault's impact hides from the
 median's residual. Spikes on one grid of a fixed interval (``spike_grid``) are completed along it. On
-every channel of the 57 development recordings (CWRU at 12 kHz, MFPT at 48.8 kHz, impacts of faulty
-bearings included) no sample is found, even at 8 sigma and 3 x; the first false find is at 6 sigma
-and 3 x. Of 500 random spikes of 30 x the RMS in every 10 s of every channel of the 53 fault records
-(alternating sign, as ``benchmarks/diagnosis_robustness.py``), 27 of 69,351 are missed, 191
-without the AR model's second look.
+every channel of the 57 development recordings (CWRU 12 kHz, MFPT 48.8 kHz, faulty bearings' impacts
+included) none is found even at 8 sigma and 3 x (a first false find at 6 sigma and 3 x). Of 500 random
+spikes of 30 x the RMS (alternating sign) in every 10 s of every channel of the 53 fault records, 27 of
+69,351 are missed, 191 without the AR model's second look.
 
-``fill`` replaces lost samples by their least-squares AR interpolation: ``despike`` and
-``vm.diagnose`` fill the spikes found, and ``vm.diagnose`` the dropouts too. The neighbours' mean,
-the repair before, misses a sample of these records by more than their RMS, and 500 such repairs in
-10 s spread noise that whitening lifts over the bearing's band: with the spikes' true places given,
-16 of the 39 right answers stayed right at 500 spikes in 10 s, and 39 with the AR fill.
-
-``flat_runs`` (dropouts) and ``clipped_share`` (saturation) measure. Filling clipped samples the
-same way was tried and made one more wrong call (CWRU B021_3 clipped at 3 x the RMS), so saturation
-is only flagged.
+``fill`` replaces lost samples by their least-squares AR interpolation (``despike`` and ``vm.diagnose``
+fill the spikes found, ``vm.diagnose`` the dropouts too): a neighbours' mean misses these records'
+samples by more than their RMS, and whitening lifts 500 such repairs in 10 s over the bearing's band
+(the spikes' true places given, 16 of 39 right answers stay right with it, 39 with the AR fill).
+``flat_runs`` (dropouts) and ``clipped_share`` (saturation) measure; saturation is flagged, not filled
+(a fill made CWRU B021_3 clipped at 3 x the RMS a wrong call).
 """
 
 from __future__ import annotations
@@ -44,7 +40,7 @@ from ..core.errors import ParameterError, warn_quality
 from ..core.record import Record
 
 __all__ = ["despike", "isolated_spikes", "fill", "flat_runs", "clipped_share", "transients", "isolated_events",
-           "gate", "spike_grid"]
+           "gate", "spike_grid", "whitened"]
 
 SPIKE_SIGMA = 10.0      # residual of a spike over the residual's robust spread (1.4826 MAD)
 SPIKE_ISOLATION = 4.0   # ... and over every other residual within SPIKE_CONTEXT samples
@@ -336,17 +332,15 @@ def clipped_share(x) -> float:
     return n / x.size
 
 
-# Transients: stretches that are not the machine's steady running. A knock on the machine, a touched cable
-# or a passing load is a burst above the record's level; an ICP sensor's bias settling, or a step, moves
-# the mean. The envelope analysis cannot survive either: the squared envelope's spectrum floor grows as the
-# square of a stretch's power, so a window at 3 x the RMS of the others adds 81 x its share to the floor,
-# and one 0.2 s burst of noise at 10 x the RMS in 10 s lifts it about 200 x (23 dB): every bearing line sinks
-# (benchmarks/diagnosis_robustness.py: the 39 right answers of 53 fell to 0, and to 7 at 3 x the RMS). A
-# settling's low frequencies lift the ISO velocity, which then lets shaft-order patterns through (4 wrong
-# "looseness" on the same records). ``vm.diagnose`` judges windows of two shaft revolutions. On the 57
-# development records (154 channels) steady windows reach 4.8 x the median window's RMS (the fan-end
-# ball-fault records: six channels have one to three such stretches, 1.3-6.2 % of the record, which the
-# 3 x level gates out; no answer changes) and a window's mean 0.87 x the median window's RMS (B007_1).
+# Transients: stretches that are not the machine's steady running. A knock, a touched cable or a passing
+# load is a burst above the record's level; an ICP sensor's bias settling, or a step, moves the mean. The
+# squared envelope's spectrum floor grows as the square of a stretch's power (a window at 3 x the others'
+# RMS adds 81 x its share; a 0.2 s burst at 10 x the RMS in 10 s lifts it 23 dB): every bearing line sinks
+# (the 39 right answers of 53 fell to 0, and to 7 at 3 x the RMS). A settling's low frequencies lift the
+# ISO velocity, letting shaft-order patterns through (4 wrong "looseness" on the same records).
+# ``vm.diagnose`` judges windows of two shaft revolutions. On the 57 development records (154 channels) steady
+# windows reach 4.8 x the median window's RMS (fan-end ball faults: six channels have one to three such
+# stretches, 1.3-6.2 % of the record, gated by the 3 x level; no answer changes), a window's mean 0.87 x (B007_1).
 #
 # A burst can bury the envelope spectrum without standing out in the RMS: an accelerometer's signal is
 # loud in its structure's resonances and quiet elsewhere, and a broadband knock fills the quiet bands,
@@ -354,23 +348,21 @@ def clipped_share(x) -> float:
 # RMS, under the level) stands, whitened, 5-12 x above the median window (two revolutions) on the drive-
 # and fan-end channels of the CWRU fan-end records and 8-25 x on their base channels, and took 39 right
 # answers of 53 to 14 (the inner race of IR007_0, p = 1e-180 as recorded, had p = 1).
-# ``transients(..., whiten=True)`` judges the whitened signal with the RMS rule, in windows of two turns
-# of the bearing's cage: a defect on a rolling element passes the load zone once a turn, and real
-# ball-fault records have loud stretches on that rhythm and slower (whitened windows of two revolutions
-# reach 4.7 x on the development records; gating them in a prototype turned fan-end OR007@12_1 into a
-# wrong inner-race call). In two-cage-turn windows only B007_1's drive- and fan-end channels pass 3 x
-# (3.6 x and 3.1 x), and no answer changes. ``vm.diagnose`` looks there once the RMS rule's transients
-# are gated (a loud burst's whitened tails would otherwise be taken too), and gates what it finds.
-# Not found: a burst that fills every band (whitening then spreads it over the record: 0.3 x the RMS on
-# a one-resonance signal with a 1 % floor), or one in a record whose structure rings in a broad band (the
-# MFPT records: 2.6-3.4 x whitened at 2 x the RMS, a fifteenth of their 3 s).
+# ``transients(..., whiten=True)`` judges the whitened signal by the RMS rule in windows of two cage
+# turns: a rolling element's defect passes the load zone once a turn, and real ball-fault records are loud
+# on that rhythm and slower (whitened two-revolution windows reach 4.7 x; gating them made fan-end
+# OR007@12_1 a wrong inner-race call). In two-cage-turn windows only B007_1's drive- and fan-end channels
+# pass 3 x (3.6, 3.1 x); no answer changes. ``vm.diagnose`` looks once the RMS rule's transients are gated
+# (a loud burst's whitened tails would be taken too). Not found: a burst that fills every band (whitened,
+# 0.3 x the RMS on a one-resonance signal with a 1 % floor), or one in a record whose structure rings in a
+# broad band (MFPT: 2.6-3.4 x whitened at 2 x the RMS, a fifteenth of their 3 s).
 TRANSIENT_LEVEL = 3.0    # a window's RMS (about its own mean) over the median window's
 TRANSIENT_OFFSET = 2.0   # a window's mean off the median window mean, in median window RMS
 TRANSIENT_SHARE = 0.25   # more than this share of the record beyond either is the machine's state, not a transient
 WHITEN_TAPER = 0.05      # share of the record tapered before it is whitened (monitor.bearing.spectra.TAPER)
 
 
-def transients(x, block: int, *, whiten: bool = False) -> list[tuple[int, int]]:
+def transients(x, block: int, *, whiten: bool = False, whitened_x: tuple | None = None) -> list[tuple[int, int]]:
     """(start, stop) of the stretches that are transients: a window of ``block`` samples (moved by half a
     block, so that a burst astride two blocks is seen whole) whose RMS about its own mean exceeds
     ``TRANSIENT_LEVEL`` x the median window's (a burst), or whose mean is off the median window mean by
@@ -380,9 +372,10 @@ def transients(x, block: int, *, whiten: bool = False) -> list[tuple[int, int]]:
     more than ``TRANSIENT_SHARE`` of the record would be marked: a level that changes that much is the
     record's own (a run-up, an intermittent machine), not a transient to remove.
 
-    ``whiten=True`` judges the windows of the signal whitened (``_whitened``: its spectrum flattened, as
+    ``whiten=True`` judges the windows of the signal whitened (``whitened``: its spectrum flattened, as
     the envelope analysis sees it), on the RMS rule alone: a broadband burst fills every band the machine
-    is quiet in, where whitening lifts it far above the rest (see the notes above ``TRANSIENT_LEVEL``)."""
+    is quiet in, where whitening lifts it far above the rest (notes above ``TRANSIENT_LEVEL``); it is
+    ``whitened_x`` where the caller has ``whitened(x)`` already."""
     x = _samples(x)
     if isinstance(block, bool) or not isinstance(block, (int, np.integer)) or block < 2:
         raise ParameterError(f"block={block!r} must be a whole number of samples, at least 2")
@@ -391,7 +384,7 @@ def transients(x, block: int, *, whiten: bool = False) -> list[tuple[int, int]]:
     if whiten:
         if x.size < 8 * block or not np.ptp(x) > 0:   # too short for _marked, or nothing to whiten
             return []
-        xw, a = _whitened(x)
+        xw, a = whitened(x) if whitened_x is None else whitened_x
         inner = x.size - 2 * a
         # judged between the tapered ends; a run that reaches an end takes the tapered samples beyond it
         return [(0 if s == 0 else s + a, x.size if e == inner else e + a)
@@ -421,13 +414,13 @@ EVENT_RATIO = 5.0
 MAX_EVENTS = 3
 
 
-def isolated_events(x, block: int) -> list[tuple[int, int]]:
+def isolated_events(x, block: int, *, whitened_x: tuple | None = None) -> list[tuple[int, int]]:
     """(start, stop) of single impacts: stretches of about ``block`` samples whose whitened RMS stands
     EVENT_LEVEL x the median window's, with an excess over the median EVENT_RATIO x that of the record's
     own loudest (the loudest window beyond the MAX_EVENTS loudest and their neighbours); at most
     MAX_EVENTS, each widened by a window before and two after (its onset and ring). More impacts than
     that, as loud, are the record's own rhythm. Empty when fewer than 16 windows fit or the signal is
-    constant.
+    constant. ``whitened_x``: ``whitened(x)`` where the caller has it already.
 
     Examples
     --------
@@ -445,7 +438,7 @@ def isolated_events(x, block: int) -> list[tuple[int, int]]:
     h = int(block) // 2
     if x.size < 16 * block or not np.ptp(x) > 0:
         return []
-    xw, a = _whitened(x)
+    xw, a = whitened(x) if whitened_x is None else whitened_x
     inner = xw[a: x.size - a]
     nu = inner.size // h
     P = (inner[: nu * h].reshape(nu, h) ** 2).sum(axis=1)
@@ -470,9 +463,19 @@ def isolated_events(x, block: int) -> list[tuple[int, int]]:
     return sorted(runs)
 
 
-def _whitened(x: np.ndarray) -> tuple[np.ndarray, int]:
-    """x cepstrally whitened (every bin of its spectrum at magnitude 1, none above the band it
-    measures), after a Tukey taper of WHITEN_TAPER; and the samples at each end the taper touches."""
+def whitened(x) -> tuple[np.ndarray, int]:
+    """(x cepstrally whitened after a Tukey taper of WHITEN_TAPER: every bin of its spectrum at magnitude
+    1, none above the band it measures; the samples at each end the taper touches): what
+    ``transients(whiten=True)`` and ``isolated_events`` judge, computed once by a caller asking both.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from vibmeasure.signal import quality
+    >>> quality.whitened(np.random.default_rng(0).normal(size=4096))[1]
+    103
+    """
+    x = _samples(x)
     from .whiten import cepstral_spectrum, measured_top, tapered_spectrum
     n = x.size
     X = tapered_spectrum(x, WHITEN_TAPER)

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...core._threads import each_in_threads
 from ...core._validate import positive
 from ...core.errors import ParameterError
 from .cage import _cage_floor
@@ -153,8 +154,8 @@ def _explained_spectra(signals, fs, f1, freqs, n_balls, band, whitening, artefac
     """Every channel's SES (cage floor divided out before the channels are fused), the fused views,
     and on each the lines explained by the shaft, artefacts, the cage and the families."""
     spectra, measured = [], {}
-    for name, x in signals.items():
-        sp, measured[name] = _spectra(x, fs, name, f1, freqs, band, whitening)
+    each = each_in_threads(lambda item: _spectra(item[1], fs, item[0], f1, freqs, band, whitening), signals.items())
+    for name, (sp, measured[name]) in zip(signals, each):
         for s in sp:   # before the channels are fused, so that a mean carries each channel's floor
             _cage_floor(s, freqs, f1, n_balls)
         spectra.extend(sp)

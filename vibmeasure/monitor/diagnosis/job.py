@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...core import units as _units
+from ...core._threads import each_in_threads
 from ...core._validate import clean_signal, positive, response_channel
 from ...core.errors import ParameterError
 from ...models.bearing import Bearing, Gear, bearing_from
@@ -66,6 +67,22 @@ def _accel(rec, i, flags, quality, block):
     return x
 
 
+def _accel_alone(rec, i, block) -> tuple:
+    """(samples, flags, findings) of channel i as ``_accel`` gives them, with flags and findings of its own."""
+    flags: list = []
+    quality: dict = {}
+    return _accel(rec, i, flags, quality, block), flags, quality
+
+
+def _take(prepared: tuple, flags: list, quality: dict) -> None:
+    """One channel's flags (each once) and findings added to the record's."""
+    _, own_flags, own_quality = prepared
+    for f in own_flags:
+        if f not in flags:
+            flags.append(f)
+    quality.update(own_quality)
+
+
 DIFFERENTIATIONS = {"acceleration": 0, "velocity": 1, "displacement": 2}
 
 
@@ -116,12 +133,15 @@ def _damage(x, fs, name, flags, quality, block):
     runs = q.transients(x, block[0])
     if runs:
         x = q.gate(x, runs, max(1, block[0] // 8))
-    hidden = q.transients(x, block[1], whiten=True)   # once the loud ones are out (quality.TRANSIENT_LEVEL)
+    # the whitened signal both rules below judge (while x stands), where the first judges it at all
+    xw = q.whitened(x) if x.size >= 8 * block[1] and np.ptp(x) > 0 else None
+    hidden = q.transients(x, block[1], whiten=True, whitened_x=xw)   # once the loud ones are out (TRANSIENT_LEVEL)
     if hidden:
         x = q.gate(x, hidden, max(1, block[0] // 8))
         runs = _merged(runs + hidden)
+        xw = None
     # a single impact (a knock) rings for milliseconds: judged in quarter-turn windows (quality.EVENT_LEVEL)
-    knocks = q.isolated_events(x, max(16, block[0] // 8))
+    knocks = q.isolated_events(x, max(16, block[0] // 8), whitened_x=xw)
     if knocks:
         x = q.gate(x, knocks, max(1, block[0] // 64))
         runs = _merged(runs + knocks)
@@ -224,18 +244,24 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
     # turns of the cage (quality.TRANSIENT_LEVEL: a ball defect passes the load zone once a turn)
     ftf = bearing.frequencies(f1)["FTF"] if bearing is not None else TYPICAL_FTF_ORDER * f1
     block = (max(64, int(round(2 * rec.fs / f1))), max(64, int(round(2 * rec.fs / ftf))))
-    a = _accel(rec, idx, flags, quality, block)
     if named is None:
         chosen = [i for i, c in enumerate(rec.channels) if c.quantity not in ("force", "time") and i not in skip]
         if idx not in chosen:
             chosen.insert(0, idx)
     else:
         chosen = list(dict.fromkeys(named))
+    # each channel prepared apart (in threads), its flags and findings taken in the serial order: the
+    # primary's first, then the others'
+    order = [idx] + [i for i in chosen if i != idx]
+    prepared = dict(zip(order, each_in_threads(lambda i: _accel_alone(rec, i, block), order)))
+    _take(prepared[idx], flags, quality)
+    if named is not None:
         vibration = [i for i, c in enumerate(rec.channels) if c.quantity not in ("force", "time") and i not in skip]
         if set(vibration) - set(chosen):   # a channel left out may be the one that sees the fault
             flags.append("channels_restricted")
-    signals = {rec.channels[i].name: (a if i == idx else _accel(rec, i, flags, quality, block))
-               for i in chosen}
+    for i in order[1:]:
+        _take(prepared[i], flags, quality)
+    signals = {rec.channels[i].name: prepared[i][0] for i in chosen}
     if band is not None:
         from ...core._validate import check_band
         band = check_band(band, rec.fs)
@@ -244,7 +270,7 @@ def _prepare(rec, rpm, bearing, gear, machine_group, foundation, channel, channe
     converted = {rec.channels[i].name: rec.channels[i].unit for i in chosen
                  if rec.channels[i].unit and DIFFERENTIATIONS.get(rec.channels[i].quantity, 0)}
     unit_share = _unit_plausibility(rec, converted, flags)
-    return Job(rec.fs, rpm, rec.channels[idx].name, a, signals, bearing, gear, group, found, band, flags,
+    return Job(rec.fs, rpm, rec.channels[idx].name, prepared[idx][0], signals, bearing, gear, group, found, band, flags,
                prewhitening=whitening, mains=mains, quality=quality, converted=converted, file_rpm=file_rpm,
                unit_share=unit_share)
 
