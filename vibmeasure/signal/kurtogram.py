@@ -49,35 +49,11 @@ def _complex_envelope(X: np.ndarray, k0: int, k1: int, n: int, length: int | Non
     return _fft.ifft(X[k0:k1], n=L) * (2.0 * L / n)
 
 
-def _negentropy_time(c: np.ndarray) -> float:
-    e = np.abs(c) ** 2
-    x = e / max(float(e.mean()), 1e-300)
-    return float(np.mean(x * np.log(np.maximum(x, 1e-300)))) - _GAUSS_NEGENTROPY
-
-
-def _negentropy_spec(c: np.ndarray, k_max: int) -> float:
-    """Negentropy of the squared envelope's spectrum over the cyclic frequencies of interest, each bin
-    normalised by its expected level for band-limited noise (a triangle in cyclic frequency)."""
-    e = np.abs(c) ** 2
-    m = e.size
-    P = np.abs(_fft.rfft(e - e.mean())) ** 2
-    k = np.arange(1, min(k_max, m // 2) + 1)
-    if k.size < 8:
-        return np.nan
-    y = P[k] / (1.0 - k / m)
-    y = y / max(float(y.mean()), 1e-300)
-    return float(np.mean(y * np.log(np.maximum(y, 1e-300)))) - _GAUSS_NEGENTROPY
-
-
-def _kurt(c: np.ndarray) -> float:
-    p = np.abs(c) ** 2
-    return float(np.mean(p ** 2) / max(float(np.mean(p)) ** 2, 1e-300) - 2.0)
-
-
 def _spectrum_map(X: np.ndarray, n: int, fs: float, *, min_bandwidth: float, max_level: float, k_cyc: int,
                   f_lo: float = 0.0, f_hi: float | None = None):
     """Kurtosis and negentropy of every band of the tree whose width is at least min_bandwidth, whose
-    lower edge is at f_lo or above and of which at least 3/4 lies below f_hi (NaN for the others)."""
+    lower edge is at f_lo or above and of which at least 3/4 lies below f_hi (NaN for the others). The
+    bands of one level and one width are transformed together (``_band_rows``)."""
     k_hi = np.inf if f_hi is None else f_hi * n / fs
     n_bins = X.size - 1
     levels, nbs, kur, neg = [], [], [], []
@@ -85,15 +61,48 @@ def _spectrum_map(X: np.ndarray, n: int, fs: float, *, min_bandwidth: float, max
         if fs / 2 / nb < min_bandwidth:
             continue
         kv, nv = np.full(nb, np.nan), np.full(nb, np.nan)
+        widths: dict = {}
         for i in range(nb):
             k0, k1 = _band_bins(n_bins, nb, i)
             if k0 * fs / n < f_lo - 1e-9 or k1 - k0 < 8 or min(k1, k_hi) - k0 < 0.75 * (k1 - k0):
                 continue
-            c = _complex_envelope(X, max(k0, 1), k1, n)
-            kv[i] = _kurt(c)
-            nv[i] = 0.5 * (_negentropy_time(c) + _negentropy_spec(c, k_cyc))
+            widths.setdefault(k1 - max(k0, 1), []).append((i, max(k0, 1)))
+        for m, bands in widths.items():
+            at = [i for i, _ in bands]
+            kv[at], nv[at] = _band_rows(X, [k0 for _, k0 in bands], m, n, k_cyc)
         levels.append(lev); nbs.append(nb); kur.append(kv); neg.append(nv)
     return tuple(levels), tuple(nbs), tuple(kur), tuple(neg)
+
+
+def _band_rows(X: np.ndarray, starts: list, m: int, n: int, k_cyc: int) -> tuple:
+    """(kurtosis, negentropy) of the bands of m bins starting at ``starts``: their complex envelopes
+    (``_complex_envelope``) in one inverse FFT of many rows, on two threads. Kurtosis E|c|^4 / (E|c|^2)^2
+    - 2; negentropy the mean of the time domain's and the envelope spectrum's (each bin of cyclic order
+    1..k_cyc normalised by its expected level for band-limited noise, a triangle in cyclic frequency),
+    each E[x ln x] of the normalised values less Gaussian noise's. Each mean is taken row by row
+    (``_row_means``): numpy sums a 2-D array's rows in another order than a row alone, and a band's
+    values must not depend on how many bands share its width."""
+    idx = np.asarray(starts)[:, None] + np.arange(m)
+    c = _fft.ifft(X[idx], n=m, axis=-1, workers=2) * (2.0 * m / n)
+    e = np.abs(c) ** 2
+    e_mean = _row_means(e)
+    # squared as a Python float (libm's pow, which may differ from x * x by a unit): the same values as
+    # the kurtogram had band by band
+    kurt = _row_means(e ** 2) / np.maximum([float(v) ** 2 for v in e_mean], 1e-300) - 2.0
+    x = e / np.maximum(e_mean, 1e-300)[:, None]
+    neg_t = _row_means(x * np.log(np.maximum(x, 1e-300))) - _GAUSS_NEGENTROPY
+    k = np.arange(1, min(k_cyc, m // 2) + 1)
+    if k.size < 8:
+        return kurt, np.full(len(starts), np.nan)
+    P = np.abs(_fft.rfft(e - e_mean[:, None], axis=-1, workers=2)) ** 2
+    y = P[:, k] / (1.0 - k / m)
+    y = y / np.maximum(_row_means(y), 1e-300)[:, None]
+    neg_s = _row_means(y * np.log(np.maximum(y, 1e-300))) - _GAUSS_NEGENTROPY
+    return kurt, 0.5 * (neg_t + neg_s)
+
+
+def _row_means(a: np.ndarray) -> np.ndarray:
+    return np.array([row.mean() for row in a])
 
 
 def kurtogram_of(x: np.ndarray | None, fs: float, *, min_bandwidth: float, max_level: float | None,
