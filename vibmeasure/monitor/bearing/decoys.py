@@ -111,6 +111,18 @@ def _scan_comb(ses: _SES, f0: float, harmonics, side, lo: float, hi: float, excl
     return float(logp), float(1 + s[j]), vals[j], terms
 
 
+def _on_base(ses: _SES, name: str, freqs: dict, f1: float) -> dict | None:
+    """The family's comb on the lines the shaft and the cage left (``r_base``): as the family test's
+    first pass found it (``base_results``), else fitted there."""
+    if ses.base_results is not None and name in ses.base_results:
+        return ses.base_results[name]
+    saved, ses.r = ses.r, ses.r_base if ses.r_base is not None else ses.r
+    try:
+        return _family(ses, name, freqs, f1)
+    finally:
+        ses.r = saved
+
+
 def _pair_max(r: np.ndarray) -> np.ndarray:
     """max(r[i], r[i + 1]) for every i: a line is read from the two bins around its position, and the
     speed scan reads a million positions of the same spectrum per record."""
@@ -155,15 +167,11 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
     # time base is in doubt already (the speed step named its factor and the test runs at that speed too)
     ranges = FACTOR_WINDOWS if confirmed else (SPEED_SCAN,) + FACTOR_WINDOWS + (UNCONFIRMED_WINDOWS if four else ())
     for ses in spectra:
-        saved, ses.r = ses.r, ses.r_base if ses.r_base is not None else ses.r
-        try:
-            for name in FAMILIES:
-                res = _family(ses, name, freqs, f1)
-                # a comb with lines halfway between its harmonics speaks for half the speed, not this one
-                if res is not None and res.get("halves", 0) < HALVES:
-                    declared = min(declared, res["logp"] + np.log(n_sp))
-        finally:
-            ses.r = saved
+        for name in FAMILIES:
+            res = _on_base(ses, name, freqs, f1)
+            # a comb with lines halfway between its harmonics speaks for half the speed, not this one
+            if res is not None and res.get("halves", 0) < HALVES:
+                declared = min(declared, res["logp"] + np.log(n_sp))
         pair_max = _pair_max(ses.r_base if ses.r_base is not None else ses.r)   # the scans below only read it
         for name, (key, models) in FAMILIES.items():
             for harmonics, side in models:

@@ -234,6 +234,8 @@ def _explain(ses: _SES, freqs: dict, f1: float, shaft_hz: float, f1_known: bool,
     while open_:
         for name in open_:
             ses.results[name] = _family(ses, name, freqs, f1)
+        if ses.base_results is None:   # every family on r_base: what the speed scan weighs against
+            ses.base_results = {name: ses.results[name] for name in open_}
         sig = [n for n in open_ if _significant(ses.results[n])]
         ok = [n for n in sig if _accepted(ses.results[n])]
         if not ok:

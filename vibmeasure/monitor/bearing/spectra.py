@@ -27,6 +27,7 @@ class _SES:
     primary: str | None = None   # the family that claimed its lines first
     kurtogram: object = None
     r_base: np.ndarray | None = None
+    base_results: dict | None = None   # each family's comb on r_base (``families._explain``'s first pass)
     shape: int = 1               # r is the mean of this many independent spectra (Gamma(shape)/shape)
     cage_floor: dict = field(default_factory=dict)   # multiple of n_balls x FTF -> (lo Hz, hi Hz, level)
     parts: tuple = ()            # a fused view's channels, each with its own band: ((channel, band), ...)
