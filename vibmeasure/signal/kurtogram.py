@@ -86,8 +86,8 @@ def _band_rows(X: np.ndarray, starts: list, m: int, n: int, k_cyc: int) -> tuple
     c = _fft.ifft(X[idx], n=m, axis=-1, workers=2) * (2.0 * m / n)
     e = np.abs(c) ** 2
     e_mean = _row_means(e)
-    # squared as a Python float (libm's pow, which may differ from x * x by a unit): the same values as
-    # the kurtogram had band by band
+    # squared as a Python float (libm's pow, which may differ from x * x by a unit): the values the
+    # validation figures were measured with, to the last bit
     kurt = _row_means(e ** 2) / np.maximum([float(v) ** 2 for v in e_mean], 1e-300) - 2.0
     x = e / np.maximum(e_mean, 1e-300)[:, None]
     neg_t = _row_means(x * np.log(np.maximum(x, 1e-300))) - _GAUSS_NEGENTROPY
