@@ -114,3 +114,25 @@ def test_the_speed_scans_declared_combs_are_the_family_tests_first_pass():
                     (fresh["logp"], fresh["slip"], fresh.get("halves"))
                 checked += 1
     assert checked >= 4 and ev.families["bearing_outer_race"]["found"]
+
+
+@pytest.mark.parametrize("x", [[], [1.0] * 5, np.zeros(100), [np.nan] + [1.0] * 40, np.ones((3, 40)), ["a"] * 20])
+def test_whitening_what_holds_no_spectrum_is_a_parameter_error(x):
+    from vibmeasure.signal.quality import whitened
+    with pytest.raises(ParameterError, match="x .*must be"):
+        whitened(x)
+
+
+def test_a_whitened_signal_given_for_another_is_refused(rng):
+    """``whitened_x=`` spares the rules a second whitening only when it is this signal's: another length
+    or shape is a ParameterError naming the argument, never a judgement of other samples."""
+    from vibmeasure.signal import quality as q
+    x = rng.normal(size=4096)
+    own = q.whitened(x)
+    assert q.transients(x, 64, whiten=True, whitened_x=own) == q.transients(x, 64, whiten=True)
+    assert q.isolated_events(x, 64, whitened_x=own) == q.isolated_events(x, 64)
+    for bad in ((np.zeros(10), 1), (own[0],), "bad", (own[0], 5000)):
+        with pytest.raises(ParameterError, match="whitened_x"):
+            q.transients(x, 64, whiten=True, whitened_x=bad)
+        with pytest.raises(ParameterError, match="whitened_x"):
+            q.isolated_events(x, 64, whitened_x=bad)

@@ -33,11 +33,11 @@ samples by more than their RMS, and whitening lifts 500 such repairs in 10 s ove
 from __future__ import annotations
 
 import numpy as np
-from scipy import fft as _fft
 
 from ..core._validate import as_record
 from ..core.errors import ParameterError, warn_quality
 from ..core.record import Record
+from .whiten import _whitened_or, whitened
 
 __all__ = ["despike", "isolated_spikes", "fill", "flat_runs", "clipped_share", "transients", "isolated_events",
            "gate", "spike_grid", "whitened"]
@@ -359,7 +359,6 @@ def clipped_share(x) -> float:
 TRANSIENT_LEVEL = 3.0    # a window's RMS (about its own mean) over the median window's
 TRANSIENT_OFFSET = 2.0   # a window's mean off the median window mean, in median window RMS
 TRANSIENT_SHARE = 0.25   # more than this share of the record beyond either is the machine's state, not a transient
-WHITEN_TAPER = 0.05      # share of the record tapered before it is whitened (monitor.bearing.spectra.TAPER)
 
 
 def transients(x, block: int, *, whiten: bool = False, whitened_x: tuple | None = None) -> list[tuple[int, int]]:
@@ -384,7 +383,7 @@ def transients(x, block: int, *, whiten: bool = False, whitened_x: tuple | None 
     if whiten:
         if x.size < 8 * block or not np.ptp(x) > 0:   # too short for _marked, or nothing to whiten
             return []
-        xw, a = whitened(x) if whitened_x is None else whitened_x
+        xw, a = _whitened_or(x, whitened_x)
         inner = x.size - 2 * a
         # judged between the tapered ends; a run that reaches an end takes the tapered samples beyond it
         return [(0 if s == 0 else s + a, x.size if e == inner else e + a)
@@ -438,7 +437,7 @@ def isolated_events(x, block: int, *, whitened_x: tuple | None = None) -> list[t
     h = int(block) // 2
     if x.size < 16 * block or not np.ptp(x) > 0:
         return []
-    xw, a = whitened(x) if whitened_x is None else whitened_x
+    xw, a = _whitened_or(x, whitened_x)
     inner = xw[a: x.size - a]
     nu = inner.size // h
     P = (inner[: nu * h].reshape(nu, h) ** 2).sum(axis=1)
@@ -461,26 +460,6 @@ def isolated_events(x, block: int, *, whitened_x: tuple | None = None) -> list[t
     runs = [(max(0, a + (k - 1) * h), min(x.size, a + (k + 3) * h)) for k in peaks[:MAX_EVENTS]
             if rms[k] >= EVENT_LEVEL * med and rms[k] - med >= EVENT_RATIO * (own - med)]
     return sorted(runs)
-
-
-def whitened(x) -> tuple[np.ndarray, int]:
-    """(x cepstrally whitened after a Tukey taper of WHITEN_TAPER: every bin of its spectrum at magnitude
-    1, none above the band it measures; the samples at each end the taper touches): what
-    ``transients(whiten=True)`` and ``isolated_events`` judge, computed once by a caller asking both.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from vibmeasure.signal import quality
-    >>> quality.whitened(np.random.default_rng(0).normal(size=4096))[1]
-    103
-    """
-    x = _samples(x)
-    from .whiten import cepstral_spectrum, measured_top, tapered_spectrum
-    n = x.size
-    X = tapered_spectrum(x, WHITEN_TAPER)
-    k_hi = int(np.floor(measured_top(X, 1.0, n) * n))
-    return _fft.irfft(cepstral_spectrum(X, k_hi), n), int(np.ceil(WHITEN_TAPER * n / 2))
 
 
 def _marked(x: np.ndarray, block: int, offset: bool) -> list[tuple[int, int]]:

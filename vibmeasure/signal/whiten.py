@@ -16,9 +16,53 @@ from ..core._validate import as_record, clean_signal, positive, response_channel
 from ..core.errors import ParameterError
 from ..core.record import Channel, Record
 
-__all__ = ["tapered_spectrum", "prewhiten", "remove_synchronous", "measured_top", "cepstral_spectrum", "edit_lines", "ar_residual", "ar_order", "synchronous_part"]
+__all__ = ["whitened", "tapered_spectrum", "prewhiten", "remove_synchronous", "measured_top", "cepstral_spectrum", "edit_lines", "ar_residual", "ar_order", "synchronous_part"]
 
 _METHODS = ("cepstral", "ar")
+WHITEN_TAPER = 0.05   # share of a record tapered before it is whitened to be judged (monitor.bearing.spectra.TAPER)
+MIN_WHITENED = 16     # samples: fewer hold no spectrum to flatten
+
+
+def whitened(x) -> tuple[np.ndarray, int]:
+    """(x cepstrally whitened after a Tukey taper of WHITEN_TAPER: every bin of its spectrum at magnitude
+    1, none above the band it measures; the samples at each end the taper touches): what
+    ``quality.transients(whiten=True)`` and ``quality.isolated_events`` judge, computed once by a caller
+    asking both (``whitened_x=``).
+
+    Raises
+    ------
+    ParameterError
+        For x not 1-D, not finite, shorter than MIN_WHITENED samples or constant.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from vibmeasure.signal.whiten import whitened
+    >>> whitened(np.random.default_rng(0).normal(size=4096))[1]
+    103
+    """
+    try:
+        x = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError("x must be an array of numbers (one channel's samples)") from None
+    if x.ndim != 1 or x.size < MIN_WHITENED or not np.isfinite(x).all() or not np.ptp(x) > 0:
+        raise ParameterError(f"x (shape {x.shape}) must be one channel's finite samples, at least {MIN_WHITENED} "
+                             "of them and not constant: there is no spectrum to whiten")
+    n = x.size
+    X = tapered_spectrum(x, WHITEN_TAPER)
+    k_hi = int(np.floor(measured_top(X, 1.0, n) * n))
+    return _fft.irfft(cepstral_spectrum(X, k_hi), n), int(np.ceil(WHITEN_TAPER * n / 2))
+
+
+def _whitened_or(x: np.ndarray, given) -> tuple[np.ndarray, int]:
+    """``whitened(x)``, or ``given`` (a caller's ``whitened_x=``) once it is checked to be x's shape."""
+    if given is None:
+        return whitened(x)
+    ok = isinstance(given, tuple) and len(given) == 2 and isinstance(given[1], (int, np.integer))
+    if not ok or np.shape(given[0]) != x.shape or not 0 <= given[1] < x.size // 2:
+        raise ParameterError(f"whitened_x must be whitened(x) of these {x.size} samples: (array of {x.size}, "
+                             "samples the taper touches)")
+    return given
 
 
 def _cepstral(x: np.ndarray) -> np.ndarray:
