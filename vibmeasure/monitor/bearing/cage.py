@@ -28,11 +28,9 @@ def _cage_shared(k_max: int, freqs: dict, f1: float, n_balls: int, df: float) ->
     lines += [h * freqs["BSF"] for h in range(1, 7)]
     lines += [h * freqs["2xBSF"] + m * ftf for h in (1, 2, 3) for m in (-1, 1)]
     lines = np.asarray(lines)
-    out = set()
-    for k in range(1, k_max + 1):
-        if k % n_balls and np.any(np.abs(k * ftf - lines) <= CONTESTED * lines + 1.5 * df):
-            out.add(k)
-    return out
+    k = np.arange(1, k_max + 1)
+    near = np.any(np.abs(k[:, None] * ftf - lines[None, :]) <= (CONTESTED * lines + 1.5 * df)[None, :], axis=1)
+    return set(k[near & (k % n_balls != 0)].tolist())
 
 
 def _claim_cage(ses: _SES, freqs: dict, f1: float, n_balls: int) -> dict | None:

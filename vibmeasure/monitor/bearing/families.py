@@ -94,19 +94,20 @@ def _claim_artefact(ses: _SES, hz: float):
 def _family(ses: _SES, name: str, freqs: dict, f1: float) -> dict | None:
     key, models = FAMILIES[name]
     best = None
+    fits = {}   # (harmonics, sidebands) -> comb: the carriers' and the modulation's combs are sub-models'
     for harmonics, side in models:
         sp = None if side is None else ((f1, 0.0) if side == "1X" else (freqs["FTF"], 1.0))
-        res = _comb(ses, freqs[key], harmonics, sp)
+        res = fits[harmonics, sp] = _comb(ses, freqs[key], harmonics, sp)
         if res is not None and (best is None or res["logp"] < best["logp"]):
             best = dict(res, model=f"{key} x {','.join(f'{h:g}' for h in harmonics)}"
                         + (f" +-{side}" if side else ""), spec=(harmonics, sp, len(models)))
     if best is not None:
         best["logp"] = min(0.0, best["logp"] + np.log(len(models)))
-        best["modulation"] = _modulation(ses, name, freqs, f1)
+        best["modulation"] = _modulation(ses, name, freqs, f1, fits)
         # the shaft modulates every family's lines (+-1X); the cage a ball's (+-FTF)
         best["denser"] = _denser(ses, freqs[key] * (1 + best["slip"]), best["spec"][0],
                                  (f1, freqs["FTF"]) if name == "bearing_ball" else (f1,))
-        car = _comb(ses, freqs[key], (1, 2, 3))
+        car = _fitted(fits, ses, freqs[key], (1, 2, 3), None)
         vals = [ln["r"] for ln in car["lines"]] if car else [0.0]
         # who claims first: the family with more of its own first three harmonics standing out, then
         # the stronger ones (capped, so that one huge shared line does not decide), then raw strength
@@ -114,16 +115,23 @@ def _family(ses: _SES, name: str, freqs: dict, f1: float) -> dict | None:
     return best
 
 
-def _modulation(ses: _SES, name: str, freqs: dict, f1: float) -> int | None:
+def _fitted(fits: dict, ses: _SES, f0: float, harmonics: tuple, sp) -> dict | None:
+    """``_comb(ses, f0, harmonics, sp)``, taken from ``fits`` where the family's sub-models fitted it on
+    the same lines."""
+    return fits[harmonics, sp] if (harmonics, sp) in fits else _comb(ses, f0, harmonics, sp)
+
+
+def _modulation(ses: _SES, name: str, freqs: dict, f1: float, fits=None) -> int | None:
     """How many modulation sidebands stand out: +-1X around BPFI harmonics (the defect turns through
     the load zone with the shaft), +-FTF around 2xBSF harmonics (the ball travels with the cage).
-    None for the outer race, whose defect stays in the load zone."""
+    None for the outer race, whose defect stays in the load zone. ``fits``: the combs ``_family``
+    fitted on these lines, (harmonics, sidebands) -> comb."""
     side = MODULATION.get(name)
     if side is None:
         return None
     key = FAMILIES[name][0]
     sp = (f1, 0.0) if side == "1X" else (freqs["FTF"], 1.0)
-    res = _comb(ses, freqs[key], (1, 2, 3), sp)
+    res = _fitted(fits or {}, ses, freqs[key], (1, 2, 3), sp)
     return 0 if res is None else sum(ln["r"] >= ses.r_line for ln in res["lines"] if ln["sideband"] != 0)
 
 

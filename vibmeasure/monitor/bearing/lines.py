@@ -4,6 +4,7 @@ p-values to posterior confidence."""
 from __future__ import annotations
 
 from functools import lru_cache
+from math import gcd
 
 import numpy as np
 
@@ -213,16 +214,30 @@ def _denser(ses: _SES, f0: float, harmonics, own_sidebands=()) -> int:
         return 0
     need = max(ses.r_line, HALF_SHARE * float(np.median(own)))
     mods = np.array([h * f0 + k * sp for h in (1, 2, 3) for sp in own_sidebands for k in (-2, -1, 1, 2)])
-    for m in range(3, DENSER_MAX + 1):
-        hz = np.array([j * f0 / m for j in range(1, 3 * m) if j % m and j * f0 / m / df >= 2])
-        if mods.size and hz.size:
-            hz = hz[np.all(np.abs(hz[:, None] - mods[None, :]) > np.maximum(1.5 * df, 0.01 * hz[:, None]), axis=1)]
-        if hz.size < 3:
-            continue
-        n = int(np.sum(heights(hz) >= need))
-        if n >= max(3, DENSER_SHARE * hz.size):
-            return m
+    # every m's places at once (each value as j * f0 / m gives it), counted per m
+    j, m = _DENSER_PLACES
+    hz = j * f0 / m
+    asked = hz / df >= 2
+    if mods.size:
+        asked &= np.all(np.abs(hz[:, None] - mods[None, :]) > np.maximum(1.5 * df, 0.01 * hz[:, None]), axis=1)
+    n_asked = np.bincount(m[asked], minlength=DENSER_MAX + 1)
+    n_high = np.bincount(m[asked & (heights(hz) >= need)], minlength=DENSER_MAX + 1)
+    for mm in range(3, DENSER_MAX + 1):
+        size = int(n_asked[mm])
+        if size >= 3 and int(n_high[mm]) >= max(3, DENSER_SHARE * size):
+            return mm
     return 0
+
+
+def _places(m_max: int) -> tuple:
+    """(j, m) of every place j / m x f0 (m = 3 .. m_max, j = 1 .. 3 m - 1, no multiple of m) that
+    ``_denser`` asks, as two read-only integer arrays."""
+    jm = np.array([(j, m) for m in range(3, m_max + 1) for j in range(1, 3 * m) if j % m]).T
+    jm.flags.writeable = False
+    return jm[0], jm[1]
+
+
+_DENSER_PLACES = _places(DENSER_MAX)
 
 
 def _step(harmonics) -> float:
@@ -231,7 +246,6 @@ def _step(harmonics) -> float:
     the lines pin the family's fundamental: harmonic 1 alone, or 1 and 2, or 2 and 3 give 1; 2 and 4
     give 2; 3 alone gives 3. In the ball family's BSF sub-model (0.5, 1, 1.5 x 2 x BSF) 0.5 x 2 x BSF
     alone gives 0.5, 2 x BSF alone 1 (its own lines); 1.5 x 2 x BSF alone gives 1.5."""
-    from math import gcd
     g = 0
     for h in harmonics:
         g = gcd(g, int(round(2 * h)))
