@@ -105,8 +105,9 @@ def _named_window(window, n: int) -> np.ndarray:
 def symmetric_window(window: str, n: int) -> np.ndarray:
     """A symmetric window of length n ("hann": np.hanning's; else scipy's with fftbins=False), read-only.
 
-    One diagnosis windows the same record length a dozen times; records up to 2^20 samples keep their
-    last four windows (32 MiB at most), longer ones are computed each time.
+    One diagnosis windows the same record length a dozen times and each envelope band's length twice:
+    the last 32 windows up to 2^17 samples and the last four up to 2^20 are kept (64 MiB at most),
+    longer ones are computed each time.
 
     Examples
     --------
@@ -115,14 +116,22 @@ def symmetric_window(window: str, n: int) -> np.ndarray:
     >>> w.tolist(), w.flags.writeable
     ([0.0, 0.5, 1.0, 0.5, 0.0], False)
     """
-    return _symmetric(window, int(n)) if n <= 2 ** 20 else _symmetric.__wrapped__(window, int(n))
+    n = int(n)
+    if n <= 2 ** 17:
+        return _symmetric_short(window, n)
+    return _symmetric(window, n) if n <= 2 ** 20 else _symmetric.__wrapped__(window, n)
 
 
-@functools.lru_cache(maxsize=4)
-def _symmetric(window: str, n: int) -> np.ndarray:
+def _window(window: str, n: int) -> np.ndarray:
     w = np.hanning(n) if window == "hann" else _sig.get_window(window, n, fftbins=False)
     w.flags.writeable = False
     return w
+
+
+# a record's envelope spectra window a dozen band lengths or more, each up to 2^17 samples: their last 32
+# are kept (32 MiB at most); whole records, up to 2^20 samples, their last four (32 MiB)
+_symmetric_short = functools.lru_cache(maxsize=32)(_window)
+_symmetric = functools.lru_cache(maxsize=4)(_window)
 
 
 def _check_dtype(dtype):

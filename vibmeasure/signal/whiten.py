@@ -147,8 +147,8 @@ def tapered_spectrum(x: np.ndarray, taper: float) -> np.ndarray:
         for k, X in _TAPERED["last"]:      # one snapshot: another thread may replace it meanwhile
             if k == key:
                 return X
-    from scipy.signal.windows import tukey
-    X = _fft.rfft((x - x.mean()) * tukey(x.size, taper))
+    from .spectral import symmetric_window
+    X = _fft.rfft((x - x.mean()) * symmetric_window(("tukey", float(taper)), x.size))
     X.flags.writeable = False
     if key is not None:
         _TAPERED["last"] = ((key, X),) + _TAPERED["last"][:3]
