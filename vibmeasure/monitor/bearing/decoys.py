@@ -162,36 +162,15 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
     ``speed_search`` of the declared one is that shaft's modulation (a 1X too weak to be found), not a
     bearing's."""
     n_sp = max(1, len(spectra))
-    found, declared = [], 0.0
     # ``four``: 4 x the speed is searched too where nothing confirmed it (UNCONFIRMED_WINDOWS), unless the
     # time base is in doubt already (the speed step named its factor and the test runs at that speed too)
     ranges = FACTOR_WINDOWS if confirmed else (SPEED_SCAN,) + FACTOR_WINDOWS + (UNCONFIRMED_WINDOWS if four else ())
-    for ses in spectra:
-        for name in FAMILIES:
-            res = _on_base(ses, name, freqs, f1)
-            # a comb with lines halfway between its harmonics speaks for half the speed, not this one
-            if res is not None and res.get("halves", 0) < HALVES:
-                declared = min(declared, res["logp"] + np.log(n_sp))
-        pair_max = _pair_max(ses.r_base if ses.r_base is not None else ses.r)   # the scans below only read it
-        for name, (key, models) in FAMILIES.items():
-            for harmonics, side in models:
-                sp = None if side is None else (f1 if side == "1X" else freqs["FTF"],)
-                # within the 1X search a comb only says the speed is somewhat off (the declared speed
-                # stands, as with a 1X found there): it counts for the declared speed
-                near = _scan_comb(ses, freqs[key], harmonics, sp, -speed_search, speed_search, pair_max=pair_max)
-                if near is not None and _halves(ses, freqs[key] * near[1], harmonics, base=True) < HALVES:
-                    declared = min(declared, near[0] + np.log(len(models)) + np.log(n_sp))
-                for lo, hi in ranges:
-                    res = _scan_comb(ses, freqs[key], harmonics, sp, lo - 1.0, hi - 1.0, max(SLIP, speed_search),
-                                     pair_max=pair_max)
-                    if res is None:
-                        continue
-                    c = _scanned(res, ses, freqs, key, harmonics, side, sp, f1, speed_search,
-                                 np.log(len(models)) + np.log(n_sp), (lo, hi) != SPEED_SCAN)
-                    if c is not None and not on_grid(ses, [hz for hz, _ in c[1]["lines"]], hunting_hz):
-                        found.append((c[0], dict(c[1], family=name, factor_window=(lo, hi) in FACTOR_WINDOWS)))
-    if not found:
+    found = [c for ses in spectra for c in _elsewhere(ses, freqs, f1, speed_search, ranges, n_sp, hunting_hz)]
+    # the declared speed's best comb only weighs a significant comb found elsewhere: without one there is
+    # neither a contradiction nor a rival, whatever it is
+    if not found or min(c[0] for c in found) >= np.log(ALPHA):
         return None, None
+    declared = min([0.0] + [_declared_best(ses, freqs, f1, speed_search, n_sp) for ses in spectra])
     found.sort(key=lambda c: c[0])
     logp, best = found[0]
     if logp >= np.log(ALPHA) or logp >= declared + np.log(SPEED_SCAN_MARGIN):
@@ -206,6 +185,48 @@ def _speed_scan(spectra: list, freqs: dict, f1: float, speed_search: float, conf
             others.append(c["factor"])
     best["other_factors"] = others
     return best, None
+
+
+def _elsewhere(ses: _SES, freqs: dict, f1: float, speed_search: float, ranges: tuple, n_sp: int,
+               hunting_hz: float | None) -> list:
+    """The combs one spectrum shows at other speeds (``ranges``, outside the 1X search): (log p, comb) in the
+    order families, sub-models and ranges are tried (``_speed_scan``)."""
+    found = []
+    pair_max = _pair_max(ses.r_base if ses.r_base is not None else ses.r)   # the scans below only read it
+    for name, (key, models) in FAMILIES.items():
+        for harmonics, side in models:
+            sp = None if side is None else (f1 if side == "1X" else freqs["FTF"],)
+            for lo, hi in ranges:
+                res = _scan_comb(ses, freqs[key], harmonics, sp, lo - 1.0, hi - 1.0, max(SLIP, speed_search),
+                                 pair_max=pair_max)
+                if res is None:
+                    continue
+                c = _scanned(res, ses, freqs, key, harmonics, side, sp, f1, speed_search,
+                             np.log(len(models)) + np.log(n_sp), (lo, hi) != SPEED_SCAN)
+                if c is not None and not on_grid(ses, [hz for hz, _ in c[1]["lines"]], hunting_hz):
+                    found.append((c[0], dict(c[1], family=name, factor_window=(lo, hi) in FACTOR_WINDOWS)))
+    return found
+
+
+def _declared_best(ses: _SES, freqs: dict, f1: float, speed_search: float, n_sp: int) -> float:
+    """The best log p (at most 0) one spectrum gives the declared speed: every family at its +-SLIP and,
+    every line scaled alike, anywhere within the 1X search (``_speed_scan``)."""
+    declared = 0.0
+    for name in FAMILIES:
+        res = _on_base(ses, name, freqs, f1)
+        # a comb with lines halfway between its harmonics speaks for half the speed, not this one
+        if res is not None and res.get("halves", 0) < HALVES:
+            declared = min(declared, res["logp"] + np.log(n_sp))
+    pair_max = _pair_max(ses.r_base if ses.r_base is not None else ses.r)
+    for name, (key, models) in FAMILIES.items():
+        for harmonics, side in models:
+            sp = None if side is None else (f1 if side == "1X" else freqs["FTF"],)
+            # within the 1X search a comb only says the speed is somewhat off (the declared speed
+            # stands, as with a 1X found there): it counts for the declared speed
+            near = _scan_comb(ses, freqs[key], harmonics, sp, -speed_search, speed_search, pair_max=pair_max)
+            if near is not None and _halves(ses, freqs[key] * near[1], harmonics, base=True) < HALVES:
+                declared = min(declared, near[0] + np.log(len(models)) + np.log(n_sp))
+    return declared
 
 
 def _rival(found: list, declared: float) -> dict | None:
