@@ -142,19 +142,23 @@ def _comb(ses: _SES, f0: float, harmonics, side=None, slip=SLIP) -> dict | None:
     if fit is None:
         return None
     harmonics, s, pos, terms, vals, T, j, logp = fit
-    n_s, df = s.size, ses.freq[1]
-    best = vals[j].tolist()
-    standing = [v >= ses.r_line for v in best]
-    lines = [{"harmonic": float(h), "sideband": int(k), "hz": float(p), "r": v}
-             for (h, k), p, v in zip(terms, pos[j].tolist(), best)]
+    n_s, df, r_line = s.size, ses.freq[1], ses.r_line
+    best, at = vals[j].tolist(), pos[j].tolist()
+    # one pass over the terms: the lines, and of those standing the counts and the step (``_step``)
+    lines, main, n_lines, n_carriers, n_odd, g = [], [], 0, 0, 0, 0
+    for (h, k), p, v in zip(terms, at, best):
+        lines.append({"harmonic": float(h), "sideband": int(k), "hz": float(p), "r": v})
+        if k == 0:
+            main.append(v)
+        if v >= r_line:
+            n_lines += 1
+            n_carriers += bool(k == 0 and h <= 3)
+            n_odd += bool(h != int(h) or int(h) % 2)
+            g = gcd(g, int(round(2 * h)))
     return {"logp": float(min(logp, 0.0)), "slip": float(s[j]), "stat": float(T[j]), "n_terms": len(terms),
-            "edge": bool((slip - abs(s[j])) * float(np.max(pos[j])) < df and T[j] > T[n_s // 2]),
-            "strength": float(np.sum([v for (h, k), v in zip(terms, vals[j]) if k == 0])),
-            "lines": lines, "n_lines": int(sum(standing)),
-            "n_carriers": int(sum(bool(st and k == 0 and h <= 3) for (h, k), st in zip(terms, standing))),
-            "n_odd": int(sum(bool(st and (h != int(h) or int(h) % 2)) for (h, k), st in zip(terms, standing))),
-            "step": _step(h for (h, k), st in zip(terms, standing) if st),
-            "halves": _halves(ses, f0 * (1 + s[j]), harmonics)}
+            "edge": bool((slip - abs(s[j])) * max(at) < df and T[j] > T[n_s // 2]),
+            "strength": float(np.sum(main)), "lines": lines, "n_lines": n_lines, "n_carriers": n_carriers,
+            "n_odd": n_odd, "step": g / 2 if g else 1.0, "halves": _halves(ses, f0 * (1 + s[j]), harmonics)}
 
 
 HALF_SHARE = 0.5   # a half-harmonic line counts from this share of the comb's own lines' median height
