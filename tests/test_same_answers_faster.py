@@ -295,34 +295,3 @@ def test_kept_windows_and_floor_maps_are_the_ones_computed_afresh():
     grid, g = _exponential_map(101)
     fresh = np.log1p(grid[:, None] / (np.log(2.0) * (100 - np.arange(51)[None, :]))).sum(axis=1)
     assert np.array_equal(g, fresh) and not g.flags.writeable and _exponential_map(101)[1] is g
-
-
-def _masked_line(freq, values, f, tol, floor_halfwidth):
-    """``diagnosis.lines._line`` as masks over the whole spectrum: the definition the index ranges keep."""
-    sel = np.abs(freq - f) <= tol
-    if not sel.any():
-        return None, 0.0, -np.inf
-    k = np.flatnonzero(sel)[np.argmax(values[sel])]
-    ring = (np.abs(freq - f) <= floor_halfwidth) & ~sel
-    floor = np.median(values[ring]) if ring.sum() >= 5 else np.median(values)
-    return float(freq[k]), float(values[k]), float(20 * np.log10(values[k] / max(floor, 1e-300)))
-
-
-def test_a_lines_windows_as_index_ranges_equal_the_masks(rng):
-    # every window edge case: f between bins and on one, outside the grid, tol 0, a floor ring narrower
-    # than the line's window, a grid cut short, f rounded to float32 (ties at the ends); to the last bit
-    from vibmeasure.monitor.diagnosis.lines import _line
-    for _ in range(3000):
-        n = int(rng.integers(1, 3000))
-        fs = float(rng.uniform(100, 50000))
-        freq = np.fft.rfftfreq(n, 1 / fs)
-        if rng.random() < 0.3:
-            freq = freq[: int(rng.integers(1, freq.size + 1))]
-        v = rng.random(freq.size) ** 3
-        df = freq[1] if freq.size > 1 else 1.0
-        f = float(rng.choice([rng.uniform(-fs / 4, fs), freq[rng.integers(freq.size)],
-                              freq[rng.integers(freq.size)] + df / 2]))
-        f = float(np.float32(f)) if rng.random() < 0.2 else f
-        tol = float(rng.choice([0.6 * df, 1.5 * df, rng.uniform(0, 50 * df), 0.0, df]))
-        half = float(rng.choice([f + 5 * df, 10 * df, rng.uniform(0, 100 * df), tol, 0.5 * tol]))
-        assert repr(_line(freq, v, f, tol, half)) == repr(_masked_line(freq, v, f, tol, half))

@@ -21,36 +21,14 @@ TOP_CONFIDENCE = 0.5   # a fault is named from this confidence on (``decide``)
 
 
 def _line(freq, values, f, tol, floor_halfwidth):
-    """Strongest value within f +- tol and its height (dB) over the local median floor (the values within
-    f +- floor_halfwidth outside f +- tol; the whole spectrum's median where fewer than 5). ``freq`` is
-    ascending (an rfft's grid, or a part of one): each window is an index range, found in O(log n) where
-    a mask over the spectrum costs O(n) and the speed, shaft and gear steps ask for hundreds of lines."""
-    a, b = _window(freq, f, tol)
-    if b <= a:
+    """Strongest value within f +- tol and its height (dB) over the local median floor."""
+    sel = np.abs(freq - f) <= tol
+    if not sel.any():
         return None, 0.0, -np.inf
-    k = a + int(np.argmax(values[a:b]))
-    c, d = _window(freq, f, floor_halfwidth)
-    ring = np.concatenate([values[c:min(a, d)], values[max(b, c):d]])
-    floor = np.median(ring) if ring.size >= 5 else np.median(values)
+    k = np.flatnonzero(sel)[np.argmax(values[sel])]
+    ring = (np.abs(freq - f) <= floor_halfwidth) & ~sel
+    floor = np.median(values[ring]) if ring.sum() >= 5 else np.median(values)
     return float(freq[k]), float(values[k]), float(20 * np.log10(values[k] / max(floor, 1e-300)))
-
-
-def _window(freq, f, tol) -> tuple[int, int]:
-    """The index range [a, b) of the ascending ``freq`` where |freq - f| <= tol, as the array expression
-    computes it: freq - f rounds monotonically, so the set is one range, and its ends are checked with
-    the same subtraction."""
-    n = len(freq)
-    a = int(np.searchsorted(freq, f - tol, "left"))
-    while a > 0 and freq[a - 1] - f >= -tol:
-        a -= 1
-    while a < n and freq[a] - f < -tol:
-        a += 1
-    b = max(a, int(np.searchsorted(freq, f + tol, "right")))
-    while b < n and freq[b] - f <= tol:
-        b += 1
-    while b > a and freq[b - 1] - f > tol:
-        b -= 1
-    return a, b
 
 
 # --- spectrum, speed, severity -------------------------------------------------------------------------
