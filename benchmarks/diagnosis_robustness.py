@@ -7,7 +7,8 @@ channel alone (whole, and in 1 s pieces). Held-out recordings come from other ri
 that generalises keeps its answers (or says "none") and does not start making wrong calls.
 
 Every fault record of ../shared/data/cwru_fe (45) and mfpt (8) goes through vm.diagnose once per
-variant; the script prints right / none / wrong per variant and the wrong calls. ``--no-guards`` turns
+variant; the script prints right / none / wrong per variant and the wrong calls, and the p-values of the
+calls that rest on one view of their record (right and wrong: whether SINGLE_VIEW_P parts them). ``--no-guards`` turns
 off the two guards against whitening what is not measurement (the taper before whitening and the
 measured band's edge), to show what they change.
 
@@ -229,6 +230,7 @@ def main(names, guards=True):
     recs = [r for r in records() if r[0] in ("cwru_fe", "mfpt")]
     print(f"{'variant':52s} {'right':>6} {'none':>6} {'wrong':>6}  time   (guards {'on' if guards else 'off'})")
     total = dict.fromkeys(("right", "none", "wrong"), 0)
+    one_view = []   # (right?, p) of every bearing call that rests on one view of its record
     for name in names:
         make = VARIANTS[name]
         counts, wrong, t0 = dict.fromkeys(("right", "none", "wrong"), 0), [], time.perf_counter()
@@ -241,12 +243,21 @@ def main(names, guards=True):
                 top = scored(d.top)   # a shaft-order or gear fault named on a bearing-fault record is wrong
                 k = "right" if top == truth else "none" if top == "none" else "wrong"
                 counts[k] += 1
+                row = d.faults.set_index("fault").loc[d.top] if d.top.startswith("bearing_") else None
+                if row is not None and (row["views"] or 0) <= 1:
+                    one_view.append((k == "right", float(row["p_value"])))
                 if k == "wrong":
                     wrong.append(f"{fname}{f' piece {j + 1}' if isinstance(made, list) else ''} ({truth} -> {d.top})")
         print(f"{name:52s} {counts['right']:>6} {counts['none']:>6} {counts['wrong']:>6}  "
               f"{time.perf_counter() - t0:4.0f} s  {'; '.join(wrong)}", flush=True)
         total = {k: total[k] + counts[k] for k in total}
     print(f"{f'all {len(names)} variants':52s} {total['right']:>6} {total['none']:>6} {total['wrong']:>6}")
+    # whether a p-value threshold on one-view calls (rules.SINGLE_VIEW_P) could part the right from the wrong
+    right = [p for ok, p in one_view if ok]
+    wrong = [p for ok, p in one_view if not ok]
+    print(f"calls resting on one view: {len(right)} right (p {min(right, default=np.nan):.1g} to "
+          f"{max(right, default=np.nan):.1g}), {len(wrong)} wrong (p {', '.join(f'{p:.1g}' for p in sorted(wrong))}); "
+          f"right ones weaker than the strongest wrong: {sum(p > min(wrong, default=0.0) for p in right)}")
 
 
 if __name__ == "__main__":
