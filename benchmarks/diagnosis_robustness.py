@@ -255,9 +255,14 @@ def main(names, guards=True):
     # whether a p-value threshold on one-view calls (rules.SINGLE_VIEW_P) could part the right from the wrong
     right = [p for ok, p in one_view if ok]
     wrong = [p for ok, p in one_view if not ok]
-    print(f"calls resting on one view: {len(right)} right (p {min(right, default=np.nan):.1g} to "
-          f"{max(right, default=np.nan):.1g}), {len(wrong)} wrong (p {', '.join(f'{p:.1g}' for p in sorted(wrong))}); "
-          f"right ones weaker than the strongest wrong: {sum(p > min(wrong, default=0.0) for p in right)}")
+    said = f"calls resting on one view: {len(right)} right"
+    if right:
+        said += f" (p {min(right):.1g} to {max(right):.1g})"
+    said += f", {len(wrong)} wrong"
+    if wrong:
+        said += (f" (p {', '.join(f'{p:.1g}' for p in sorted(wrong))}); right ones weaker than the strongest "
+                 f"wrong: {sum(p > min(wrong) for p in right)}")
+    print(said)
 
 
 if __name__ == "__main__":
